@@ -1,0 +1,163 @@
+"""Frozen maze configurations, their seed streams and the train/test splits.
+
+A configuration (wall layout, spawn cell, object cells) is a pure function of
+``(scenario, difficulty, split, index)``: its seed is derived with
+``numpy.random.SeedSequence`` from those integers alone, so it is the same on
+every machine and Python version. Train and test draw from disjoint streams
+(the split is part of the seed) and, on top of that, every wall layout belongs
+to exactly one split by a hash of its walls: a layout that hashes to the other
+split is redrawn. So no test layout can equal a training layout, whatever the
+set sizes.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import hashlib
+from collections.abc import Sequence
+
+import numpy as np
+
+from mjmaze import maze
+
+SPLITS = ("train", "test")
+DEFAULT_NUM_CONFIGS = {"train": 256, "test": 64}
+CONFIG_SAMPLING = ("cycle", "random")
+
+# Fixed codes that enter every seed: changing them changes every maze.
+_ROOT_ENTROPY = 0x6D6A6D617A65  # "mjmaze" in ASCII
+_SCENARIO_CODES = {"labyrinth": 1, "find_return": 2, "k_item": 3, "two_colour": 4}
+_SPLIT_CODES = {"train": 0, "test": 1}
+
+
+@dataclasses.dataclass(frozen=True)
+class LayoutSpec:
+    """How a scenario lays out its mazes at one difficulty."""
+
+    grid_size: int
+    cell_size: float
+    keep_probability: float
+    num_objects: int
+    # The first object sits at the grid centre (the Two-colour totem).
+    centre_object: bool = False
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class MazeConfig:
+    """One frozen maze: walls (see :mod:`mjmaze.maze`), spawn cell and object cells.
+
+    Cells are ``(row, column)``; rows run along +y, columns along +x, and the
+    maze is centred on the origin.
+    """
+
+    scenario: str
+    difficulty: int
+    split: str
+    index: int
+    cell_size: float
+    h_walls: np.ndarray
+    v_walls: np.ndarray
+    spawn_cell: tuple[int, int]
+    object_cells: tuple[tuple[int, int], ...]
+
+    @property
+    def size(self) -> int:
+        return self.h_walls.shape[1]
+
+    def cell_centre(self, cell: tuple[int, int]) -> tuple[float, float]:
+        """World ``(x, y)`` of a cell's centre, in metres."""
+        half = (self.size - 1) / 2
+        return ((cell[1] - half) * self.cell_size, (cell[0] - half) * self.cell_size)
+
+    def layout_key(self) -> bytes:
+        """Bytes that identify the wall layout (equal keys = equal layouts)."""
+        return layout_key(self.h_walls, self.v_walls)
+
+    def __repr__(self) -> str:
+        return (
+            f"MazeConfig({self.scenario!r}, difficulty={self.difficulty}, split={self.split!r}, "
+            f"index={self.index}, size={self.size}, spawn={self.spawn_cell}, objects={self.object_cells})"
+        )
+
+
+def layout_key(h_walls: np.ndarray, v_walls: np.ndarray) -> bytes:
+    size = h_walls.shape[1]
+    return size.to_bytes(2, "little") + np.packbits(h_walls).tobytes() + np.packbits(v_walls).tobytes()
+
+
+def layout_split(h_walls: np.ndarray, v_walls: np.ndarray) -> str:
+    """The split a wall layout belongs to, from a hash of its walls."""
+    digest = hashlib.sha256(layout_key(h_walls, v_walls)).digest()
+    return SPLITS[digest[0] & 1]
+
+
+@functools.lru_cache(maxsize=8192)
+def generate_config(scenario: str, difficulty: int, split: str, index: int, spec: LayoutSpec) -> MazeConfig:
+    """The configuration ``index`` of ``(scenario, difficulty, split)``."""
+    if split not in SPLITS:
+        raise ValueError(f"split must be one of {SPLITS}, got {split!r}")
+    if scenario not in _SCENARIO_CODES:
+        raise ValueError(f"unknown scenario {scenario!r}; valid: {tuple(_SCENARIO_CODES)}")
+    if index < 0:
+        raise ValueError(f"index must be >= 0, got {index}")
+    seed = np.random.SeedSequence(
+        [_ROOT_ENTROPY, _SCENARIO_CODES[scenario], int(difficulty), _SPLIT_CODES[split], int(index)]
+    )
+    rng = np.random.default_rng(seed)
+    while True:  # redraw layouts that belong to the other split (about half)
+        h_walls, v_walls = maze.generate_walls(spec.grid_size, spec.keep_probability, rng)
+        if layout_split(h_walls, v_walls) == split:
+            break
+    h_walls.flags.writeable = False
+    v_walls.flags.writeable = False
+
+    n = spec.grid_size
+    free = np.arange(n * n)
+    fixed: list[int] = []
+    if spec.centre_object:
+        centre = (n // 2) * n + n // 2
+        fixed.append(centre)
+        free = free[free != centre]
+    drawn = rng.choice(free, size=1 + spec.num_objects - len(fixed), replace=False)
+    spawn, others = int(drawn[0]), [int(c) for c in drawn[1:]]
+    to_cell = lambda flat: (flat // n, flat % n)  # noqa: E731
+    return MazeConfig(
+        scenario=scenario,
+        difficulty=int(difficulty),
+        split=split,
+        index=int(index),
+        cell_size=spec.cell_size,
+        h_walls=h_walls,
+        v_walls=v_walls,
+        spawn_cell=to_cell(spawn),
+        object_cells=tuple(to_cell(c) for c in fixed + others),
+    )
+
+
+class ConfigSet(Sequence):
+    """The first ``num_configs`` configurations of one (scenario, difficulty, split).
+
+    Configurations are generated lazily and cached, so a large set costs
+    nothing until its mazes are used.
+    """
+
+    def __init__(self, scenario: str, difficulty: int, split: str, spec: LayoutSpec, num_configs: int | None = None):
+        if split not in SPLITS:
+            raise ValueError(f"split must be one of {SPLITS}, got {split!r}")
+        if num_configs is None:
+            num_configs = DEFAULT_NUM_CONFIGS[split]
+        if int(num_configs) < 1:
+            raise ValueError(f"num_configs must be >= 1, got {num_configs}")
+        self.scenario, self.difficulty, self.split, self.spec = scenario, int(difficulty), split, spec
+        self._num_configs = int(num_configs)
+
+    def __len__(self) -> int:
+        return self._num_configs
+
+    def __getitem__(self, index):  # type: ignore[override]
+        if isinstance(index, slice):
+            return [self[i] for i in range(*index.indices(len(self)))]
+        if not -len(self) <= index < len(self):
+            raise IndexError(f"configuration {index} out of range for a set of {len(self)}")
+        return generate_config(self.scenario, self.difficulty, self.split, index % len(self), self.spec)

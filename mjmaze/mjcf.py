@@ -1,0 +1,189 @@
+"""MJCF for a maze arena, built from ``xml_templates/`` and rewritten per maze.
+
+One model is compiled per (scenario, grid size): it holds a *pool* of wall
+collision boxes, one per possible wall segment of the grid, and one visual mesh
+with room for all of them. :class:`WallLayout` turns on the boxes of the walls a
+configuration has (the rest stay in place with collisions off) and rewrites
+the visual mesh in place, so a new maze every episode costs no
+recompile and no new GL context (see PERFORMANCE.md).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib.resources
+import pathlib
+import xml.etree.ElementTree as ET
+from collections.abc import Sequence
+
+import mujoco
+import numpy as np
+
+WALL_THICKNESS = 0.125
+WALL_HEIGHT = 1.0
+WALL_MESH = "walls"
+
+# Per wall box in the visual mesh: 8 corners, 4 side faces + the top (10
+# triangles; the bottom is never seen), one normal per visible face.
+_BOX_VERTS, _BOX_FACES, _BOX_NORMALS = 8, 10, 5
+_SIDE_CORNERS = ((0, 1), (1, 2), (2, 3), (3, 0))
+
+
+@dataclasses.dataclass(frozen=True)
+class ObjectGeom:
+    """A scenario object added to the arena (an item, a pillar, the totem).
+
+    Objects are world geoms placed per episode by writing ``model.geom_pos``;
+    ``z`` is the height of the geom's centre.
+    """
+
+    name: str
+    type: str
+    size: tuple[float, ...]
+    rgba: tuple[float, float, float, float]
+    z: float
+    collides: bool = False
+
+
+def template_path(name: str = "arena.xml"):
+    """Path of a file in ``xml_templates/``, found relative to the package."""
+    try:  # installed: pyproject.toml maps xml_templates/ to mjmaze.xml_templates
+        return importlib.resources.files("mjmaze.xml_templates").joinpath(name)
+    except ModuleNotFoundError:  # a source checkout on sys.path: the folder beside the package
+        return pathlib.Path(__file__).resolve().parent.parent / "xml_templates" / name
+
+
+def wall_segments(grid_size: int, cell_size: float) -> np.ndarray:
+    """Every possible wall segment of the grid as rows ``(x, y, half_x, half_y)``.
+
+    Horizontal segments come first, in ``h_walls`` order, then vertical ones in
+    ``v_walls`` order (see :mod:`mjmaze.maze`). Segments overlap by the wall
+    thickness at the corners so that corners are closed.
+    """
+    n, half = grid_size, (grid_size - 1) / 2
+    long_half, short_half = (cell_size + WALL_THICKNESS) / 2, WALL_THICKNESS / 2
+    rows = []
+    for i in range(n + 1):
+        for j in range(n):
+            rows.append(((j - half) * cell_size, (i - 0.5 - half) * cell_size, long_half, short_half))
+    for i in range(n):
+        for j in range(n + 1):
+            rows.append(((j - 0.5 - half) * cell_size, (i - half) * cell_size, short_half, long_half))
+    return np.array(rows, dtype=np.float64)
+
+
+def build_xml(grid_size: int, cell_size: float, objects: Sequence[ObjectGeom] = ()) -> str:
+    """The MJCF of an arena for ``grid_size x grid_size`` cells of ``cell_size`` metres."""
+    root = ET.fromstring(template_path().read_text())
+    worldbody = root.find("worldbody")
+    asset = root.find("asset")
+    segments = wall_segments(grid_size, cell_size)
+
+    half_extent = grid_size * cell_size / 2 + WALL_THICKNESS
+    # Plane grid spacing of one cell: a fine grid makes llvmpipe ~10x slower.
+    ET.SubElement(
+        worldbody, "geom", name="floor", type="plane", material="floor",
+        size=f"{half_extent} {half_extent} {cell_size}",
+    )
+    # A placeholder mesh with room for every segment (disjoint unit boxes, so the
+    # compiler merges no vertices); apply_walls overwrites it before first use.
+    capacity = len(segments)
+    offsets = np.stack([np.arange(capacity) * 2.0, np.zeros(capacity)], axis=1)
+    verts, faces, _, _ = _box_mesh(np.hstack([offsets, np.full((capacity, 2), 0.5)]))
+    ET.SubElement(
+        asset, "mesh", name=WALL_MESH, inertia="shell",
+        vertex=" ".join(f"{v:.4f}" for v in verts.ravel()),
+        face=" ".join(str(f) for f in faces.ravel()),
+    )
+    ET.SubElement(worldbody, "geom", name="walls_visual", type="mesh", mesh=WALL_MESH, material="wall")
+    for k, (x, y, hx, hy) in enumerate(segments):
+        ET.SubElement(
+            worldbody, "geom", name=f"wall_{k}", **{"class": "wall_collision"},
+            # Compiled in place: MuJoCo's midphase keeps the world body's
+            # geom bounding boxes from compile time, so boxes never move.
+            size=f"{hx} {hy} {WALL_HEIGHT / 2}", pos=f"{x} {y} {WALL_HEIGHT / 2}",
+        )
+    for obj in objects:
+        attrs = dict(
+            name=obj.name, type=obj.type, size=" ".join(map(str, obj.size)),
+            rgba=" ".join(map(str, obj.rgba)), pos=f"0 0 {obj.z}",
+        )
+        if obj.collides:
+            attrs.update(contype="1", conaffinity="1")
+        ET.SubElement(worldbody, "geom", **{"class": "item"}, **attrs)
+    return ET.tostring(root, encoding="unicode")
+
+
+def _box_mesh(boxes: np.ndarray):
+    """Vertices, faces, normals and face-normal indices of boxes ``(x, y, hx, hy)``
+    standing on the floor, ``WALL_HEIGHT`` tall, as one mesh."""
+    k = len(boxes)
+    x, y, hx, hy = (boxes[:, i : i + 1] for i in range(4))
+    corner_x = np.hstack([x - hx, x + hx, x + hx, x - hx])  # counter-clockwise from above
+    corner_y = np.hstack([y - hy, y - hy, y + hy, y + hy])
+    verts = np.zeros((k, _BOX_VERTS, 3))
+    verts[:, :4, 0] = verts[:, 4:, 0] = corner_x
+    verts[:, :4, 1] = verts[:, 4:, 1] = corner_y
+    verts[:, 4:, 2] = WALL_HEIGHT
+
+    local_faces = []
+    for a, b in _SIDE_CORNERS:  # outward-facing, counter-clockwise
+        local_faces += [(a, b, b + 4), (a, b + 4, a + 4)]
+    local_faces += [(4, 5, 6), (4, 6, 7)]
+    faces = np.array(local_faces)[None] + (np.arange(k) * _BOX_VERTS)[:, None, None]
+
+    side_normals = np.array([(0, -1, 0), (1, 0, 0), (0, 1, 0), (-1, 0, 0), (0, 0, 1)], dtype=np.float64)
+    normals = np.broadcast_to(side_normals, (k, _BOX_NORMALS, 3))
+    local_face_normal = np.repeat(np.arange(_BOX_NORMALS), 2)[:, None].repeat(3, axis=1)
+    face_normals = local_face_normal[None] + (np.arange(k) * _BOX_NORMALS)[:, None, None]
+    return verts.reshape(-1, 3), faces.reshape(-1, 3), normals.reshape(-1, 3), face_normals.reshape(-1, 3)
+
+
+class WallLayout:
+    """Writes a configuration's walls into a compiled arena model.
+
+    After :meth:`apply`, re-upload mesh :attr:`mesh_id` to every rendering
+    context of the model.
+    """
+
+    def __init__(self, model: mujoco.MjModel, grid_size: int, cell_size: float):
+        self._model = model
+        self._segments = wall_segments(grid_size, cell_size)
+        first = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "wall_0")
+        self._box_ids = np.arange(first, first + len(self._segments))
+        self.mesh_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MESH, WALL_MESH)
+        visual = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "walls_visual")
+        # Mesh vertices are written in world coordinates: undo the compiler's
+        # recentring of the placeholder mesh.
+        model.geom_pos[visual] = 0.0
+        model.geom_quat[visual] = (1.0, 0.0, 0.0, 0.0)
+        model.geom_rbound[visual] = 0.0  # 0 = never culled by bounding sphere
+        vert_adr, face_adr, normal_adr = (
+            model.mesh_vertadr[self.mesh_id], model.mesh_faceadr[self.mesh_id], model.mesh_normaladr[self.mesh_id]
+        )
+        n = len(self._segments)
+        self._verts = model.mesh_vert[vert_adr : vert_adr + n * _BOX_VERTS]
+        self._faces = model.mesh_face[face_adr : face_adr + n * _BOX_FACES]
+        self._face_normals = model.mesh_facenormal[face_adr : face_adr + n * _BOX_FACES]
+        self._normals = model.mesh_normal[normal_adr : normal_adr + n * _BOX_NORMALS]
+
+    def apply(self, h_walls: np.ndarray, v_walls: np.ndarray) -> None:
+        model = self._model
+        present = np.concatenate([h_walls.ravel(), v_walls.ravel()])
+        if present.shape != (len(self._segments),):
+            raise ValueError(f"wall arrays do not fit this arena ({len(self._segments)} segments)")
+        kept = self._segments[present]
+        # Collision boxes: only the present ones collide.
+        ids = self._box_ids
+        model.geom_contype[ids] = present
+        model.geom_conaffinity[ids] = present
+        # Visual mesh: kept boxes first, the rest degenerate (zero-area faces).
+        verts, faces, normals, face_normals = _box_mesh(kept)
+        self._verts[:] = 0.0
+        self._faces[:] = 0
+        self._face_normals[:] = 0
+        self._normals[:] = 0.0
+        self._verts[: len(verts)] = verts
+        self._faces[: len(faces)] = faces
+        self._face_normals[: len(face_normals)] = face_normals
+        self._normals[: len(normals)] = normals

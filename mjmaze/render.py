@@ -1,0 +1,197 @@
+"""Headless GL backend choice and the lean offscreen ego renderer.
+
+Backend: ``MUJOCO_GL=egl`` or ``MUJOCO_GL=osmesa`` selects one; unset, EGL is
+used when an EGL device can be opened (a GPU where there is one; pick which
+with ``MUJOCO_EGL_DEVICE_ID``), else OSMesa. Nothing is chosen at import: the
+first renderer made in a process picks the backend and creates the process's
+one GL context, which every renderer then shares.
+
+The per-frame path is only ``mjv_updateScene`` -> ``mjr_render`` ->
+``mjr_readPixels`` into a preallocated buffer; the frame is returned as a
+flipped view of that buffer (GL images are bottom-up).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import sys
+
+import mujoco
+import numpy as np
+
+BACKENDS = ("egl", "osmesa")
+DEBIAN_PACKAGES = {"egl": "libegl1 libgl1-mesa-dri", "osmesa": "libosmesa6"}
+
+# Geom groups: 0-2 drawn; 3 = collision shapes; 5 = hidden objects.
+HIDDEN_GROUP = 5
+_VISIBLE_GROUPS = (1, 1, 1, 0, 0, 0)
+
+
+class GLBackendError(RuntimeError):
+    """No headless OpenGL backend could be started."""
+
+
+def _install_hint() -> str:
+    return (
+        "mjmaze renders offscreen with EGL or OSMesa. Install them with\n"
+        f"  sudo apt-get install {DEBIAN_PACKAGES['egl']} {DEBIAN_PACKAGES['osmesa']}\n"
+        "(or run `make setup`), then pick one with MUJOCO_GL=egl or MUJOCO_GL=osmesa."
+    )
+
+
+def _egl_device_available() -> bool:
+    """True if libEGL opens a device display.
+
+    Probed with ctypes rather than by importing ``mujoco.egl``: that import
+    fixes PyOpenGL's platform for the whole process, which would rule out an
+    OSMesa fallback.
+    """
+    try:
+        egl = ctypes.CDLL("libEGL.so.1")
+    except OSError:
+        return False
+    egl.eglGetProcAddress.restype = ctypes.c_void_p
+    egl.eglGetProcAddress.argtypes = [ctypes.c_char_p]
+    query_address = egl.eglGetProcAddress(b"eglQueryDevicesEXT")
+    display_address = egl.eglGetProcAddress(b"eglGetPlatformDisplayEXT")
+    if not query_address or not display_address:
+        return False
+    query_devices = ctypes.CFUNCTYPE(ctypes.c_uint, ctypes.c_int, ctypes.c_void_p, ctypes.POINTER(ctypes.c_int))(
+        query_address
+    )
+    get_display = ctypes.CFUNCTYPE(ctypes.c_void_p, ctypes.c_uint, ctypes.c_void_p, ctypes.c_void_p)(display_address)
+    devices = (ctypes.c_void_p * 16)()
+    count = ctypes.c_int(0)
+    if not query_devices(16, devices, ctypes.byref(count)):
+        return False
+    egl.eglInitialize.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p]
+    egl_platform_device = 0x313F
+    for device in devices[: count.value]:
+        display = get_display(egl_platform_device, device, None)
+        if display and egl.eglInitialize(display, None, None):
+            return True
+    return False
+
+
+def _osmesa_available() -> bool:
+    try:
+        ctypes.CDLL("libOSMesa.so.8")
+    except OSError:
+        try:
+            ctypes.CDLL("libOSMesa.so")
+        except OSError:
+            return False
+    return True
+
+
+def choose_backend() -> str:
+    """The backend this process will use: ``MUJOCO_GL`` if set, else EGL, else OSMesa."""
+    requested = os.environ.get("MUJOCO_GL", "").strip().lower()
+    if requested:
+        if requested not in BACKENDS:
+            raise GLBackendError(
+                f"MUJOCO_GL={requested!r} is not a headless backend mjmaze can use; "
+                f"set it to one of {BACKENDS} or unset it.\n" + _install_hint()
+            )
+        return requested
+    if _egl_device_available():
+        return "egl"
+    if _osmesa_available():
+        return "osmesa"
+    raise GLBackendError("Neither EGL nor OSMesa could be opened.\n" + _install_hint())
+
+
+_gl_context = None
+_gl_backend: str | None = None
+_gl_pid: int | None = None
+
+
+def gl_context():
+    """The process's shared GL context, created (and made current) on first use."""
+    global _gl_context, _gl_backend, _gl_pid
+    if _gl_context is not None and _gl_pid == os.getpid():
+        return _gl_context
+    # llvmpipe rasterises in the calling thread with LP_NUM_THREADS=0, which is
+    # faster for our tiny frames (PERFORMANCE.md); a user's setting wins. Set
+    # before the probe below, which may load the driver.
+    os.environ.setdefault("LP_NUM_THREADS", "0")
+    backend = choose_backend()
+    platform = os.environ.get("PYOPENGL_PLATFORM")
+    if platform and platform.lower() != backend and "OpenGL" in sys.modules:
+        raise GLBackendError(
+            f"PyOpenGL was already loaded for platform {platform!r} in this process, so the {backend!r} "
+            f"backend cannot start. Set MUJOCO_GL={platform.lower()} (or PYOPENGL_PLATFORM={backend}) "
+            "before anything renders."
+        )
+    os.environ["PYOPENGL_PLATFORM"] = backend
+    try:
+        if backend == "egl":
+            from mujoco.egl import GLContext
+        else:
+            from mujoco.osmesa import GLContext
+        context = GLContext(1024, 1024)
+        context.make_current()
+    except Exception as error:  # noqa: BLE001 - any failure here means "no usable GL"
+        raise GLBackendError(f"The {backend!r} GL backend failed to start: {error}\n" + _install_hint()) from error
+    _gl_context, _gl_backend, _gl_pid = context, backend, os.getpid()
+    return context
+
+
+def gl_backend() -> str | None:
+    """The backend in use in this process, or None before the first render."""
+    return _gl_backend if _gl_pid == os.getpid() else None
+
+
+class EgoRenderer:
+    """Renders one camera of one model into a reused uint8 RGB buffer.
+
+    Several renderers share the process's GL context; each owns its MuJoCo
+    context (meshes are per model, and the wall mesh is rewritten per maze).
+    """
+
+    def __init__(self, model: mujoco.MjModel, camera: str, width: int, height: int):
+        gl_context()
+        model.vis.global_.offwidth = max(model.vis.global_.offwidth, width)
+        model.vis.global_.offheight = max(model.vis.global_.offheight, height)
+        self._model = model
+        self._context = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_50)
+        self._scene = mujoco.MjvScene(model, maxgeom=max(model.ngeom, 1))
+        for flag in (
+            mujoco.mjtRndFlag.mjRND_SHADOW,
+            mujoco.mjtRndFlag.mjRND_REFLECTION,
+            mujoco.mjtRndFlag.mjRND_SKYBOX,
+            mujoco.mjtRndFlag.mjRND_FOG,
+            mujoco.mjtRndFlag.mjRND_HAZE,
+        ):
+            self._scene.flags[flag] = 0
+        self._option = mujoco.MjvOption()
+        self._option.geomgroup[:] = _VISIBLE_GROUPS
+        self._perturb = mujoco.MjvPerturb()
+        self._camera = mujoco.MjvCamera()
+        self._camera.type = mujoco.mjtCamera.mjCAMERA_FIXED
+        self._camera.fixedcamid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, camera)
+        if self._camera.fixedcamid < 0:
+            raise ValueError(f"the model has no camera named {camera!r}")
+        self._viewport = mujoco.MjrRect(0, 0, width, height)
+        self._buffer = np.empty((height, width, 3), dtype=np.uint8)
+        self._frame = self._buffer[::-1]  # bottom-up GL image, flipped without a copy
+        self._catmask = int(mujoco.mjtCatBit.mjCAT_ALL)
+        self._offscreen = int(mujoco.mjtFramebuffer.mjFB_OFFSCREEN)
+
+    def upload_mesh(self, mesh_id: int) -> None:
+        """Re-sends a mesh whose vertices changed in the model."""
+        mujoco.mjr_uploadMesh(self._model, self._context, mesh_id)
+
+    def render(self, data: mujoco.MjData) -> np.ndarray:
+        """Renders the current state; the result is a view into a reused buffer."""
+        mujoco.mjv_updateScene(self._model, data, self._option, self._perturb, self._camera, self._catmask, self._scene)
+        mujoco.mjr_setBuffer(self._offscreen, self._context)
+        mujoco.mjr_render(self._viewport, self._scene, self._context)
+        mujoco.mjr_readPixels(self._buffer, None, self._viewport, self._context)
+        return self._frame
+
+    def close(self) -> None:
+        if self._context is not None:
+            self._context.free()
+            self._context = None

@@ -1,0 +1,252 @@
+"""The shared maze task: configurations, actions -> motion, pick-ups, time limit, pose info.
+
+A scenario subclasses :class:`MazeTask` and states only its rules: which
+objects the arena has (:attr:`MazeTask.objects`), how an episode starts
+(:meth:`MazeTask.start_episode`) and what one agent step pays and whether it
+ends the episode (:meth:`MazeTask.scenario_step`). Stepping, rendering and the
+time limit live here, once.
+"""
+
+from __future__ import annotations
+
+import collections
+import math
+from collections.abc import Sequence
+
+import mujoco as mj
+import numpy as np
+from dm_control import mujoco
+from dm_control.rl import control
+from dm_control.suite import base
+from dm_env import specs
+
+from mjmaze import configs, mjcf, render
+
+# Timing: one physics step is one Doom tic; the agent acts every 4 tics.
+TICS_PER_STEP = 4
+EPISODE_STEPS = 525  # 2100 tics
+# Motion per agent step in open space.
+FORWARD_PER_STEP = 0.25  # metres
+TURN_PER_STEP = math.radians(15.0)
+# An item is picked up when the agent's centre is this close (floor plane).
+PICKUP_RADIUS = 0.3
+AGENT_RADIUS = 0.125
+
+DEFAULT_WIDTH, DEFAULT_HEIGHT = 112, 64
+CAMERA = "ego"
+
+# (forward, turn) per action; turn +1 is to the left (counter-clockwise).
+ACTION_SETS = {
+    "default": ((0, 1), (0, -1), (1, 0), (1, 1), (1, -1)),
+    "extended": ((0, 1), (0, -1), (1, 0), (1, 1), (1, -1), (-1, 0), (-1, 1), (-1, -1)),
+}
+ACTION_NAMES = (
+    "turn_left", "turn_right", "forward", "forward_left", "forward_right",
+    "backward", "backward_left", "backward_right",
+)
+
+
+class MazePhysics(mujoco.Physics):
+    """Physics of a maze arena, with named accessors for the agent."""
+
+    def agent_pose(self) -> tuple[float, float, float]:
+        """``(x, y, yaw)`` of the agent; yaw in radians in ``(-pi, pi]``, 0 facing +x."""
+        x, y, yaw = self.data.qpos[:3]
+        return float(x), float(y), float(math.remainder(yaw, math.tau))
+
+    def set_agent_pose(self, x: float, y: float, yaw: float) -> None:
+        self.data.qpos[:3] = (x, y, yaw)
+        self.data.qvel[:3] = 0.0
+
+    def geom_id(self, name: str) -> int:
+        return mj.mj_name2id(self.model.ptr, mj.mjtObj.mjOBJ_GEOM, name)
+
+    def place_geom(self, geom_id: int, x: float, y: float) -> None:
+        """Moves a world geom (an object) to ``(x, y)``; takes effect at the next forward."""
+        self.model.geom_pos[geom_id, :2] = (x, y)
+
+
+class MazeTask(base.Task):
+    """Base of every scenario; see the module docstring."""
+
+    #: Objects this scenario adds to the arena.
+    objects: Sequence[mjcf.ObjectGeom] = ()
+    #: The scenario's name, as passed to ``mjmaze.load`` (it also enters the maze seeds).
+    scenario: str = ""
+
+    def __init__(
+        self,
+        difficulty: int,
+        layout: configs.LayoutSpec,
+        split: str = "train",
+        num_configs: int | None = None,
+        config_sampling: str = "cycle",
+        first_config: int = 0,
+        action_set: str = "default",
+        width: int = DEFAULT_WIDTH,
+        height: int = DEFAULT_HEIGHT,
+        random=None,
+    ):
+        super().__init__(random=random)
+        _check_choice("split", split, configs.SPLITS)
+        _check_choice("config_sampling", config_sampling, configs.CONFIG_SAMPLING)
+        _check_choice("action_set", action_set, tuple(ACTION_SETS))
+        for name, value in (("width", width), ("height", height)):
+            if not isinstance(value, (int, np.integer)) or not 16 <= value <= 1024:
+                raise ValueError(f"{name} must be an integer in 16..1024, got {value!r}")
+        self.layout = layout
+        self.configs = configs.ConfigSet(self.scenario, difficulty, split, layout, num_configs)
+        self._config_sampling = config_sampling
+        self._first_config = int(first_config)
+        self._actions = ACTION_SETS[action_set]
+        self._width, self._height = int(width), int(height)
+        self._episode = 0
+        self._renderer: render.EgoRenderer | None = None
+        self._walls: mjcf.WallLayout | None = None
+        self._bound_data = None
+        self.config: configs.MazeConfig | None = None
+        self._config_in_model: configs.MazeConfig | None = None
+        self._steps = 0
+        self._reward = 0.0
+        self._ended = False
+
+    # -- configuration and episode start ---------------------------------
+
+    def reseed(self, seed: int | None) -> None:
+        """Restarts the episode sequence: same seed, same episodes."""
+        self.random.seed(seed)
+        self._episode = 0
+
+    def _bind(self, physics: MazePhysics) -> None:
+        """Caches the raw MuJoCo structures of ``physics`` (once per physics)."""
+        data = physics.data.ptr
+        if data is self._bound_data:
+            return
+        self.close()
+        model = physics.model.ptr
+        self._model, self._bound_data = model, data
+        self._qpos, self._qvel = data.qpos, data.qvel
+        self._walls = mjcf.WallLayout(model, self.layout.grid_size, self.layout.cell_size)
+        self._renderer = render.EgoRenderer(model, CAMERA, self._width, self._height)
+        self._config_in_model = None
+        self._speed = FORWARD_PER_STEP / (TICS_PER_STEP * model.opt.timestep)
+        self._turn_rate = TURN_PER_STEP / (TICS_PER_STEP * model.opt.timestep)
+
+    def next_config_index(self) -> int:
+        if self._config_sampling == "random":
+            return int(self.random.randint(len(self.configs)))
+        return (self._first_config + self._episode) % len(self.configs)
+
+    def initialize_episode(self, physics: MazePhysics) -> None:
+        self._bind(physics)
+        config = self.configs[self.next_config_index()]
+        self._episode += 1
+        if config is not self._config_in_model:
+            self._walls.apply(config.h_walls, config.v_walls)
+            self._renderer.upload_mesh(self._walls.mesh_id)
+            self._config_in_model = config
+        self.config = config
+        self._steps, self._reward, self._ended = 0, 0.0, False
+        x, y, yaw = self.spawn_pose(config)
+        physics.set_agent_pose(x, y, yaw)
+        self.start_episode(physics, config)
+
+    def spawn_pose(self, config: configs.MazeConfig) -> tuple[float, float, float]:
+        """Spawn at the spawn cell's centre with a uniformly drawn heading."""
+        x, y = config.cell_centre(config.spawn_cell)
+        return x, y, self.random.uniform(-math.pi, math.pi)
+
+    # -- scenario hooks --------------------------------------------------
+
+    def start_episode(self, physics: MazePhysics, config: configs.MazeConfig) -> None:
+        """Places the scenario's objects and resets its state."""
+        raise NotImplementedError
+
+    def scenario_step(self, physics: MazePhysics, x: float, y: float) -> tuple[float, bool]:
+        """Applies the rules after one agent step at ``(x, y)``: ``(reward, episode ends)``."""
+        raise NotImplementedError
+
+    def metrics(self) -> dict:
+        """The scenario's metric fields for ``info``."""
+        raise NotImplementedError
+
+    # -- the per-step path ------------------------------------------------
+
+    def before_step(self, action, physics: MazePhysics) -> None:
+        forward, turn = self._actions[int(action)]
+        # Head along the middle of this step's turn, so a forward+turn step
+        # follows the chord of its arc.
+        heading = self._qpos[2] + 0.5 * turn * TURN_PER_STEP
+        speed = forward * self._speed
+        # No actuators: the velocity holds for the step's 4 tics unless a
+        # contact takes its normal part away (the agent slides along walls).
+        self._qvel[0] = speed * math.cos(heading)
+        self._qvel[1] = speed * math.sin(heading)
+        self._qvel[2] = turn * self._turn_rate
+
+    def after_step(self, physics: MazePhysics) -> None:
+        self._steps += 1
+        self._reward, self._ended = self.scenario_step(physics, self._qpos[0], self._qpos[1])
+
+    def get_observation(self, physics: MazePhysics) -> collections.OrderedDict:
+        self._bind(physics)
+        return collections.OrderedDict(pixels=self._renderer.render(self._bound_data).copy())
+
+    def get_reward(self, physics: MazePhysics) -> float:
+        return self._reward
+
+    def get_termination(self, physics: MazePhysics) -> float | None:
+        # Discount 0 for a task end, 1 for the time limit: adapters can tell
+        # termination from truncation.
+        if self._ended:
+            return 0.0
+        if self._steps >= EPISODE_STEPS:
+            return 1.0
+        return None
+
+    # -- specs and analysis -------------------------------------------------
+
+    def action_spec(self, physics: MazePhysics) -> specs.DiscreteArray:
+        return specs.DiscreteArray(len(self._actions), name="action")
+
+    def observation_spec(self, physics: MazePhysics) -> collections.OrderedDict:
+        return collections.OrderedDict(
+            pixels=specs.Array((self._height, self._width, 3), np.uint8, name="pixels")
+        )
+
+    @property
+    def action_names(self) -> tuple[str, ...]:
+        return ACTION_NAMES[: len(self._actions)]
+
+    @property
+    def steps(self) -> int:
+        """Agent steps taken in the current episode."""
+        return self._steps
+
+    def get_info(self, physics: MazePhysics) -> dict:
+        """Metric fields, the agent's pose and where the episode stands."""
+        x, y, yaw = physics.agent_pose()
+        info = self.metrics()
+        info.update(x=x, y=y, yaw=yaw, step=self._steps, config_index=self.config.index if self.config else -1)
+        return info
+
+    def close(self) -> None:
+        """Frees the renderer's GL resources."""
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+        self._bound_data = None
+
+
+def make_environment(task: MazeTask, environment_kwargs: dict | None = None) -> control.Environment:
+    """Compiles the task's arena and wraps it in a dm_control environment."""
+    xml = mjcf.build_xml(task.layout.grid_size, task.layout.cell_size, task.objects)
+    physics = MazePhysics.from_xml_string(xml)
+    kwargs = dict(n_sub_steps=TICS_PER_STEP, legacy_step=False)
+    kwargs.update(environment_kwargs or {})
+    return control.Environment(physics, task, **kwargs)
+
+
+def _check_choice(name: str, value, valid: Sequence) -> None:
+    if value not in valid:
+        raise ValueError(f"{name} must be one of {tuple(valid)}, got {value!r}")

@@ -1,0 +1,67 @@
+"""Labyrinth: find the exit of a maze.
+
+Action Space
+    ``DiscreteArray(5)``: turn left, turn right, forward, forward+left,
+    forward+right (``action_set="extended"`` adds backward, backward+left,
+    backward+right).
+Observation
+    ``pixels``: uint8 RGB ``(64, 112, 3)`` from the agent's eye, 0.32 m high.
+Rewards
+    +1 on reaching the exit; -0.0001 per tic (-0.0004 per agent step).
+Termination
+    Reaching the exit (discount 0) or 525 agent steps (discount 1).
+Arguments
+    ``size`` (5, 7, 9, 11, 13), ``split``, ``num_configs``, ``config_sampling``,
+    ``first_config``, ``action_set``, ``width``, ``height``, ``random``.
+Metric
+    ``success``: whether the exit was reached (success rate = mean over episodes).
+"""
+
+from __future__ import annotations
+
+from dm_control.rl import control
+
+from mjmaze import configs, maze, mjcf
+from mjmaze.tasks import base
+
+SIZES = (5, 7, 9, 11, 13)
+DEFAULT_SIZE = 9
+CELL_SIZE = 1.0
+EXIT_REWARD = 1.0
+STEP_REWARD = -0.0001 * base.TICS_PER_STEP
+
+EXIT = mjcf.ObjectGeom("exit", "box", (0.12, 0.12, 0.3), (1.0, 0.55, 0.0, 1.0), z=0.3)
+
+
+class Labyrinth(base.MazeTask):
+    """Find the exit; see the module docstring."""
+
+    scenario = "labyrinth"
+    objects = (EXIT,)
+
+    def __init__(self, size: int = DEFAULT_SIZE, **kwargs):
+        base._check_choice("size", size, SIZES)
+        layout = configs.LayoutSpec(size, CELL_SIZE, maze.DEFAULT_KEEP_PROBABILITY, num_objects=1)
+        super().__init__(difficulty=size, layout=layout, **kwargs)
+        self._exit_xy = (0.0, 0.0)
+        self._success = False
+
+    def start_episode(self, physics: base.MazePhysics, config: configs.MazeConfig) -> None:
+        self._exit_xy = config.cell_centre(config.object_cells[0])
+        physics.place_geom(physics.geom_id(EXIT.name), *self._exit_xy)
+        self._success = False
+
+    def scenario_step(self, physics: base.MazePhysics, x: float, y: float) -> tuple[float, bool]:
+        dx, dy = x - self._exit_xy[0], y - self._exit_xy[1]
+        if dx * dx + dy * dy < base.PICKUP_RADIUS**2:
+            self._success = True
+            return STEP_REWARD + EXIT_REWARD, True
+        return STEP_REWARD, False
+
+    def metrics(self) -> dict:
+        return {"success": self._success}
+
+
+def labyrinth(size: int = DEFAULT_SIZE, environment_kwargs: dict | None = None, **task_kwargs) -> control.Environment:
+    """Labyrinth of ``size x size`` cells as a dm_control environment."""
+    return base.make_environment(Labyrinth(size=size, **task_kwargs), environment_kwargs)
