@@ -1,0 +1,42 @@
+# mjmaze: `make run` runs the main job, `make test` runs the tests; both set
+# up everything they need first (Debian GL packages, a virtualenv, the package).
+SHELL := /bin/bash
+PYTHON ?= python3
+VENV ?= .venv
+PY := $(VENV)/bin/python
+# EGL (default) and OSMesa (fallback) for headless rendering.
+GL_PACKAGES := libegl1 libgl1 libgl1-mesa-dri libegl-mesa0 libglx-mesa0 libosmesa6
+
+.PHONY: run test bench setup system-deps clean
+
+run: system-deps $(VENV)/.stamp-viz
+	$(PY) -m mjmaze.rollout --scenario labyrinth --size 9 --steps 5000
+
+test: system-deps $(VENV)/.stamp-dev
+	$(PY) -m pytest -q
+
+bench: system-deps $(VENV)/.stamp-bench
+	$(PY) bench/speed.py
+
+setup: system-deps $(VENV)/.stamp-all
+
+system-deps:
+	@if ! command -v dpkg >/dev/null; then \
+	  echo "Not a Debian system: install EGL or OSMesa yourself ($(GL_PACKAGES))."; exit 0; fi; \
+	missing=$$(for p in $(GL_PACKAGES); do dpkg -s $$p >/dev/null 2>&1 || echo $$p; done); \
+	if [ -z "$$missing" ]; then exit 0; fi; \
+	if [ "$$(id -u)" != 0 ]; then echo "Missing GL packages; run: sudo apt-get install $$missing"; exit 1; fi; \
+	echo "Installing GL packages: $$missing"; \
+	apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $$missing >/dev/null
+
+$(VENV)/bin/python:
+	@$(PYTHON) -c 'import sys; sys.exit(sys.version_info < (3, 10))' || { echo "mjmaze needs Python >= 3.10"; exit 1; }
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install -q --upgrade pip
+
+$(VENV)/.stamp-%: pyproject.toml | $(VENV)/bin/python
+	$(PY) -m pip install -q -e ".[$*]"
+	@touch $@
+
+clean:
+	rm -rf $(VENV) *.egg-info .pytest_cache

@@ -1,0 +1,78 @@
+"""Random-policy rollout: ``python -m mjmaze.rollout --size 9 --steps 5000``.
+
+Prints episodes, success rate and obs/s, and writes a strip of frames as a PNG
+(the main job of ``make run`` until the baseline agent lands).
+"""
+
+from __future__ import annotations
+
+import argparse
+import pathlib
+import time
+
+import numpy as np
+
+import mjmaze
+from mjmaze import render
+
+
+def rollout(scenario: str, steps: int, seed: int, strip_frames: int, **task_kwargs) -> dict:
+    """Runs a uniformly random policy for ``steps`` agent steps."""
+    env = mjmaze.load(scenario, task_kwargs={"random": seed, **task_kwargs})
+    rng = np.random.default_rng(seed)
+    num_actions = env.action_spec().num_values
+    frames, successes, returns, episode_return = [], [], [], 0.0
+    keep_every = max(1, steps // strip_frames)
+    timestep = env.reset()
+    start = time.perf_counter()
+    for step in range(steps):
+        timestep = env.step(rng.integers(num_actions))
+        episode_return += timestep.reward
+        if step % keep_every == 0 and len(frames) < strip_frames:
+            frames.append(timestep.observation["pixels"])
+        if timestep.last():
+            successes.append(env.task.metrics()["success"])
+            returns.append(episode_return)
+            episode_return = 0.0
+            env.reset()
+    elapsed = time.perf_counter() - start
+    env.task.close()
+    return {
+        "episodes": len(successes),
+        "success_rate": float(np.mean(successes)) if successes else 0.0,
+        "mean_return": float(np.mean(returns)) if returns else 0.0,
+        "obs_per_s": steps / elapsed,
+        "frames": frames,
+    }
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--scenario", default="labyrinth", choices=mjmaze.ALL_TASKS)
+    parser.add_argument("--size", type=int, default=9, help="maze size n (n x n cells)")
+    parser.add_argument("--split", default="train", choices=("train", "test"))
+    parser.add_argument("--steps", type=int, default=5000, help="agent steps to run")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--strip-frames", type=int, default=8, help="frames in the PNG strip")
+    parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("runs/rollout/frames.png"))
+    args = parser.parse_args(argv)
+
+    result = rollout(args.scenario, args.steps, args.seed, args.strip_frames, size=args.size, split=args.split)
+    print(f"{args.scenario} {args.size}x{args.size} ({args.split}), random policy, {args.steps} agent steps")
+    print(f"  episodes finished : {result['episodes']}")
+    print(f"  success rate      : {100 * result['success_rate']:.1f}%")
+    print(f"  mean return       : {result['mean_return']:.3f}")
+    print(f"  speed             : {result['obs_per_s']:.0f} obs/s (one process, GL backend {render.gl_backend()})")
+
+    import imageio.v3 as iio  # only needed for the picture
+
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    strip = np.concatenate(result["frames"], axis=1)
+    tmp = args.out.with_suffix(".tmp.png")
+    iio.imwrite(tmp, strip)
+    tmp.replace(args.out)  # never leave a half-written picture
+    print(f"  frames            : {args.out} ({strip.shape[1]}x{strip.shape[0]})")
+
+
+if __name__ == "__main__":
+    main()
