@@ -1,0 +1,144 @@
+"""The public API: dm_control and gymnasium contracts, for every task; bad input."""
+
+import warnings
+
+import gymnasium
+import numpy as np
+import pytest
+from dm_control.rl import control
+from dm_env import specs
+from gymnasium.utils.env_checker import check_env
+
+import mjmaze
+from mjmaze.tasks import labyrinth
+
+
+@pytest.fixture(params=mjmaze.ALL_TASKS)
+def task_name(request):
+    return request.param
+
+
+def test_all_tasks_lists_every_scenario_with_a_gym_id():
+    assert "labyrinth" in mjmaze.ALL_TASKS
+    assert set(mjmaze.GYM_IDS) == set(mjmaze.ALL_TASKS)
+    for env_id in mjmaze.GYM_IDS.values():
+        assert env_id in gymnasium.registry
+
+
+def test_dm_control_specs(task_name):
+    env = mjmaze.load(task_name)
+    assert isinstance(env, control.Environment)
+    assert env.action_spec() == specs.DiscreteArray(5, name="action")
+    pixels = env.observation_spec()["pixels"]
+    assert (pixels.shape, pixels.dtype) == ((64, 112, 3), np.uint8)
+    timestep = env.reset()
+    assert timestep.first()
+    pixels.validate(timestep.observation["pixels"])
+    env.task.close()
+
+
+def test_extended_action_set(task_name):
+    env = mjmaze.load(task_name, task_kwargs={"action_set": "extended"})
+    assert env.action_spec().num_values == 8
+    env.reset()
+    assert env.step(7).mid()
+    env.task.close()
+
+
+def test_observation_size_is_configurable(task_name):
+    env = mjmaze.load(task_name, task_kwargs={"width": 64, "height": 48})
+    assert env.reset().observation["pixels"].shape == (48, 64, 3)
+    env.task.close()
+
+
+def test_observations_are_fresh_arrays(task_name):
+    # Like dm_control's suite_test: a returned observation is never overwritten later.
+    env = mjmaze.load(task_name, task_kwargs={"random": 0})
+    first = env.reset().observation["pixels"]
+    kept = first.copy()
+    second = env.step(0).observation["pixels"]
+    assert not np.shares_memory(first, second)
+    assert np.array_equal(first, kept)
+    env.task.close()
+
+
+def test_different_starts_after_reset(task_name):
+    env = mjmaze.load(task_name, task_kwargs={"random": 0})
+    starts = {env.reset().observation["pixels"].tobytes() for _ in range(4)}
+    assert len(starts) == 4
+    env.task.close()
+
+
+def test_gymnasium_spaces_and_info(task_name):
+    env = gymnasium.make(mjmaze.GYM_IDS[task_name], render_mode="rgb_array")
+    assert env.action_space == gymnasium.spaces.Discrete(5)
+    assert env.observation_space == gymnasium.spaces.Box(0, 255, (64, 112, 3), np.uint8)
+    obs, info = env.reset(seed=1)
+    assert {"x", "y", "yaw"} <= set(info)
+    obs, reward, terminated, truncated, info = env.step(2)
+    assert obs.shape == (64, 112, 3) and isinstance(reward, float)
+    assert {"x", "y", "yaw"} <= set(info)
+    assert np.array_equal(env.render(), obs)
+    env.close()
+
+
+def test_gymnasium_reset_seed_is_reproducible():
+    env = gymnasium.make("mjmaze/Labyrinth-v0", size=7, config_sampling="random")
+    runs = []
+    for _ in range(2):
+        obs, info = env.reset(seed=7)
+        frames = [obs]
+        for action in [2, 2, 0, 2, 3, 4, 2, 1]:
+            frames.append(env.step(action)[0])
+        runs.append((np.stack(frames), info["config_index"], info["yaw"]))
+    assert np.array_equal(runs[0][0], runs[1][0])
+    assert runs[0][1:] == runs[1][1:]
+    env.close()
+
+
+def test_labyrinth_success_info_through_gymnasium():
+    env = gymnasium.make("mjmaze/Labyrinth-v0", size=5)
+    env.reset(seed=0)
+    task = env.unwrapped.task
+    ex, ey = task.config.cell_centre(task.config.object_cells[0])
+    env.unwrapped.physics.set_agent_pose(ex - 0.35, ey, 0.0)
+    _, reward, terminated, truncated, info = env.step(2)
+    assert (terminated, truncated, info["success"]) == (True, False, True)
+    assert reward == pytest.approx(1 - 0.0004)
+    env.close()
+
+
+@pytest.mark.parametrize("size", labyrinth.SIZES)
+def test_check_env_passes_without_warnings(size):
+    env = gymnasium.make("mjmaze/Labyrinth-v0", size=size, split="train", render_mode="rgb_array")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(env.unwrapped, skip_render_check=False)
+    env.close()
+
+
+@pytest.mark.parametrize(
+    "name, kwargs, expected",
+    [
+        ("doom", {}, "labyrinth"),  # unknown scenario lists the valid ones
+        ("labyrinth", {"size": 4}, "(5, 7, 9, 11, 13)"),
+        ("labyrinth", {"size": 15}, "(5, 7, 9, 11, 13)"),
+        ("labyrinth", {"split": "val"}, "('train', 'test')"),
+        ("labyrinth", {"colour": "red"}, "size"),  # unknown kwarg lists the valid ones
+        ("labyrinth", {"config_sampling": "shuffle"}, "('cycle', 'random')"),
+        ("labyrinth", {"action_set": "full"}, "('default', 'extended')"),
+        ("labyrinth", {"num_configs": 0}, "num_configs"),
+        ("labyrinth", {"width": 3}, "width"),
+    ],
+)
+def test_bad_input_raises_a_value_error_listing_valid_choices(name, kwargs, expected):
+    with pytest.raises(ValueError) as error:
+        mjmaze.load(name, task_kwargs=kwargs)
+    assert expected in str(error.value)
+
+
+def test_bad_input_through_gymnasium():
+    with pytest.raises(ValueError, match=r"\(5, 7, 9, 11, 13\)"):
+        gymnasium.make("mjmaze/Labyrinth-v0", size=15)
+    with pytest.raises(ValueError, match="size"):
+        gymnasium.make("mjmaze/Labyrinth-v0", colour="red")

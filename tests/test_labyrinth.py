@@ -1,0 +1,189 @@
+"""Labyrinth rules and the agent's motion, driven by scripted actions."""
+
+import math
+
+import numpy as np
+import pytest
+
+import mjmaze
+from mjmaze.tasks import base, labyrinth
+
+from conftest import FORWARD, TURN_LEFT, find_cell, open_run, place, yaw_difference
+
+
+def test_exit_pays_one_and_ends_the_episode(labyrinth9):
+    env = labyrinth9
+    ex, ey = env.task.config.cell_centre(env.task.config.object_cells[0])
+    place(env, ex - 0.35, ey, 0.0)  # same cell, 0.35 m short of the exit, facing it
+    timestep = env.step(FORWARD)
+    assert timestep.last()
+    assert timestep.discount == 0.0  # a task end, not a truncation
+    assert timestep.reward == pytest.approx(labyrinth.EXIT_REWARD + labyrinth.STEP_REWARD)
+    assert env.task.metrics() == {"success": True}
+
+
+def test_every_other_step_costs_four_tics(labyrinth9):
+    timestep = labyrinth9.step(TURN_LEFT)
+    assert timestep.mid()
+    assert timestep.reward == pytest.approx(-0.0004)
+    assert labyrinth9.task.metrics() == {"success": False}
+
+
+def test_time_limit_is_525_agent_steps_and_truncates(labyrinth9):
+    env = labyrinth9
+    for step in range(1, base.EPISODE_STEPS + 1):
+        timestep = env.step(TURN_LEFT)  # spinning in place never reaches the exit
+        if step < base.EPISODE_STEPS:
+            assert timestep.mid(), step
+    assert timestep.last()
+    assert timestep.discount == 1.0
+    assert env.task.metrics() == {"success": False}
+    assert env.step(TURN_LEFT).first()  # the next step starts a new episode
+
+
+def test_a_free_straight_run_covers_a_quarter_metre_per_step(labyrinth9):
+    env = labyrinth9
+    config = env.task.config
+    cell = find_cell(config, lambda c: open_run(config, c, 2) and c not in config.object_cells)
+    x, y = config.cell_centre(cell)
+    place(env, x, y, 0.0)
+    for k in range(1, 5):
+        env.step(FORWARD)
+        px, py, yaw = env.physics.agent_pose()
+        assert px - x == pytest.approx(0.25 * k, abs=0.01)
+        assert py == pytest.approx(y, abs=1e-6)
+
+
+def test_a_turn_is_fifteen_degrees(labyrinth9):
+    env = labyrinth9
+    yaw0 = env.physics.agent_pose()[2]
+    for k in range(1, 7):
+        env.step(TURN_LEFT)
+        assert yaw_difference(env.physics.agent_pose()[2], yaw0 + math.radians(15 * k)) < math.radians(0.1)
+    env.step(1)  # turn right
+    assert yaw_difference(env.physics.agent_pose()[2], yaw0 + math.radians(75)) < math.radians(0.1)
+
+
+def _walled_cell(config):
+    """A cell with a wall on its +x side."""
+    return find_cell(config, lambda c: config.v_walls[c[0], c[1] + 1] and c not in config.object_cells)
+
+
+@pytest.mark.parametrize("index", range(4))
+def test_a_wall_stops_a_forward_run(index):
+    env = mjmaze.load("labyrinth", task_kwargs={"size": 9, "first_config": index})
+    env.reset()
+    config = env.task.config
+    cell = _walled_cell(config)
+    x, y = config.cell_centre(cell)
+    wall_face = x + config.cell_size / 2 - 0.0625
+    place(env, x, y, 0.0)
+    for _ in range(12):
+        env.step(FORWARD)
+        px = env.physics.agent_pose()[0]
+        assert px <= wall_face - 0.05, "the agent reached into the wall"
+    # It is stopped at its radius (0.125 m) from the wall, give or take a bounce.
+    assert px == pytest.approx(wall_face - base.AGENT_RADIUS, abs=0.04)
+    env.task.close()
+
+
+def test_the_agent_slides_along_a_wall(labyrinth9):
+    env = labyrinth9
+    config = env.task.config
+    # A wall on +x and an open cell on +y, so the slide has room.
+    cell = find_cell(
+        config,
+        lambda c: config.v_walls[c[0], c[1] + 1]
+        and c[0] + 1 < config.size
+        and not config.h_walls[c[0] + 1, c[1]]
+        and c not in config.object_cells,
+    )
+    x, y = config.cell_centre(cell)
+    wall_face = x + config.cell_size / 2 - 0.0625
+    place(env, x + 0.2, y - 0.3, math.radians(30))  # heading into the wall at 30 degrees
+    for _ in range(3):
+        env.step(FORWARD)
+    px, py, _ = env.physics.agent_pose()
+    assert px < wall_face - 0.05
+    assert py > y - 0.3 + 0.2  # kept moving along the wall
+
+
+def test_frames_are_bit_identical_for_the_same_seed_and_actions():
+    def run():
+        env = mjmaze.load("labyrinth", task_kwargs={"size": 7, "random": 42, "config_sampling": "random"})
+        frames = [env.reset().observation["pixels"]]
+        actions = np.random.default_rng(0).integers(5, size=120)
+        for action in actions:
+            timestep = env.step(action)
+            frames.append(timestep.observation["pixels"])
+        env.task.close()
+        return np.stack(frames)
+
+    first, second = run(), run()
+    assert np.array_equal(first, second)
+    assert len({f.tobytes() for f in first}) > 10  # the agent saw different things
+
+
+def test_frames_change_when_the_agent_turns(labyrinth9):
+    before = labyrinth9.step(TURN_LEFT).observation["pixels"]
+    after = labyrinth9.step(TURN_LEFT).observation["pixels"]
+    assert before.std() > 0
+    assert np.abs(before.astype(int) - after.astype(int)).mean() > 1.0
+
+
+def test_the_exit_is_visible_when_faced(labyrinth9):
+    env = labyrinth9
+    ex, ey = env.task.config.cell_centre(env.task.config.object_cells[0])
+
+    def exit_pixels(yaw):
+        place(env, ex - 0.3, ey, yaw)
+        frame = env.task.get_observation(env.physics)["pixels"].astype(float)
+        # Shaded by the headlight, the exit keeps its hue: strong red, no blue.
+        return ((frame[..., 0] > 150) & (frame[..., 2] < 60)).sum()
+
+    assert exit_pixels(0.0) > 50  # facing it
+    assert exit_pixels(math.pi) == 0  # back turned
+
+
+def test_cycle_and_random_config_sampling():
+    env = mjmaze.load("labyrinth", task_kwargs={"size": 5, "num_configs": 3})
+    seen = []
+    for _ in range(7):
+        env.reset()
+        seen.append(env.task.config.index)
+    assert seen == [0, 1, 2, 0, 1, 2, 0]
+    env.task.close()
+    env = mjmaze.load("labyrinth", task_kwargs={"size": 5, "config_sampling": "random", "random": 1})
+    drawn = set()
+    for _ in range(30):
+        env.reset()
+        drawn.add(env.task.config.index)
+    assert len(drawn) > 20 and max(drawn) < 256
+    env.task.close()
+
+
+def test_spawn_heading_is_drawn_per_episode():
+    env = mjmaze.load("labyrinth", task_kwargs={"size": 5, "num_configs": 1, "random": 3})
+    headings = set()
+    for _ in range(5):
+        env.reset()
+        headings.add(round(env.physics.agent_pose()[2], 6))
+    assert len(headings) == 5
+    env.task.close()
+
+
+def test_a_new_maze_changes_the_walls_the_agent_meets():
+    env = mjmaze.load("labyrinth", task_kwargs={"size": 5, "num_configs": 2})
+    env.reset()
+    first = env.task.config
+    env.reset()
+    second = env.task.config
+    # A cell walled on +x in the first maze but open in the second.
+    cell = find_cell(first, lambda c: first.v_walls[c[0], c[1] + 1] and not second.v_walls[c[0], c[1] + 1]
+                     and c[1] + 1 < 5 and c not in second.object_cells and (c[0], c[1] + 1) not in second.object_cells)
+    x, y = second.cell_centre(cell)
+    place(env, x, y, 0.0)
+    for _ in range(3):
+        env.step(FORWARD)
+    assert env.physics.agent_pose()[0] > x + 0.6  # walked through where the old wall stood
+    env.task.close()

@@ -1,0 +1,70 @@
+"""Headless rendering: both backends work, and a missing one gives a clear error."""
+
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from mjmaze import render
+
+_RENDER_ONE = """
+import json, numpy as np, mjmaze
+from mjmaze import render
+env = mjmaze.load("labyrinth", task_kwargs={{"size": 7, "random": 0}})
+frames = [env.reset().observation["pixels"]] + [env.step(a).observation["pixels"] for a in (0, 0, 2, 2)]
+np.save({path!r}, np.stack(frames))
+print(json.dumps({{"backend": render.gl_backend()}}))
+"""
+
+
+def _render_with(backend, tmp_path):
+    path = str(tmp_path / f"{backend}.npy")
+    env = {**os.environ, "MUJOCO_GL": backend}
+    env.pop("PYOPENGL_PLATFORM", None)
+    out = subprocess.run(
+        [sys.executable, "-c", _RENDER_ONE.format(path=path)], env=env, capture_output=True, text=True, timeout=120
+    )
+    assert out.returncode == 0, out.stderr
+    return json.loads(out.stdout.strip().splitlines()[-1])["backend"], np.load(path)
+
+
+def test_egl_and_osmesa_both_render_the_same_scene(tmp_path):
+    egl_backend, egl = _render_with("egl", tmp_path)
+    osmesa_backend, osmesa = _render_with("osmesa", tmp_path)
+    assert (egl_backend, osmesa_backend) == ("egl", "osmesa")
+    for frames in (egl, osmesa):
+        assert frames.shape == (5, 64, 112, 3)
+        assert all(frame.std() > 5 for frame in frames)  # real images, not a clear colour
+    # Same rasteriser family, same scene: the pictures agree.
+    assert np.abs(egl.astype(int) - osmesa.astype(int)).mean() < 2.0
+
+
+def test_unknown_backend_name_is_a_clear_error(monkeypatch):
+    monkeypatch.setenv("MUJOCO_GL", "glx")
+    with pytest.raises(render.GLBackendError, match="egl.*osmesa"):
+        render.choose_backend()
+
+
+def test_no_backend_names_the_debian_packages(monkeypatch):
+    monkeypatch.delenv("MUJOCO_GL", raising=False)
+    monkeypatch.setattr(render, "_egl_device_available", lambda: False)
+    monkeypatch.setattr(render, "_osmesa_available", lambda: False)
+    with pytest.raises(render.GLBackendError) as error:
+        render.choose_backend()
+    message = str(error.value)
+    assert "apt-get install" in message and "libegl1" in message and "libosmesa6" in message
+
+
+def test_osmesa_is_the_fallback_when_egl_is_missing(monkeypatch):
+    monkeypatch.delenv("MUJOCO_GL", raising=False)
+    monkeypatch.setattr(render, "_egl_device_available", lambda: False)
+    monkeypatch.setattr(render, "_osmesa_available", lambda: True)
+    assert render.choose_backend() == "osmesa"
+
+
+def test_egl_is_the_default_where_it_works(monkeypatch):
+    monkeypatch.delenv("MUJOCO_GL", raising=False)
+    assert render.choose_backend() == "egl"  # CI installs EGL (Mesa's software device)
