@@ -1,0 +1,143 @@
+"""Single-process speed of one Labyrinth env: full step vs the raw render path.
+
+    python bench/speed.py [--size 9] [--steps 3000] [--rounds 5]
+
+Prints obs/s for, alternating in rounds so machine drift hits every side:
+  render      mjv_updateScene + mjr_render + mjr_readPixels alone (the agent moving)
+  raw         the lean loop: 4 x mj_step + the render path (PERFORMANCE.md's "lean path")
+  dm_control  env.step(action) of mjmaze.load("labyrinth"): action -> physics -> rules -> observation copy
+  gymnasium   env.step(action) of gymnasium.make("mjmaze/Labyrinth-v0") (through its default wrappers)
+and the ratios full step / raw, plus a per-phase split of the full step.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+import gymnasium
+import mujoco
+import numpy as np
+
+import mjmaze
+from mjmaze import render
+
+
+def _lean_setup(size: int):
+    env = mjmaze.load("labyrinth", task_kwargs={"size": size, "random": 0})
+    env.reset()
+    model, data = env.physics.model.ptr, env.physics.data.ptr
+    return env, model, data, env.task._renderer
+
+
+def bench_render(size: int, steps: int) -> float:
+    env, model, data, renderer = _lean_setup(size)
+    rng = np.random.default_rng(0)
+    yaws = rng.uniform(-np.pi, np.pi, steps)
+    start = time.perf_counter()
+    for yaw in yaws:
+        data.qpos[2] = yaw
+        mujoco.mj_kinematics(model, data)
+        renderer.render(data)
+    rate = steps / (time.perf_counter() - start)
+    env.task.close()
+    return rate
+
+
+def bench_raw(size: int, steps: int) -> float:
+    env, model, data, renderer = _lean_setup(size)
+    rng = np.random.default_rng(0)
+    velocities = rng.uniform(-2, 2, (steps, 3))
+    start = time.perf_counter()
+    for velocity in velocities:
+        data.qvel[:3] = velocity
+        mujoco.mj_step(model, data, 4)
+        renderer.render(data)
+    rate = steps / (time.perf_counter() - start)
+    env.task.close()
+    return rate
+
+
+def bench_dm_control(size: int, steps: int) -> float:
+    env = mjmaze.load("labyrinth", task_kwargs={"size": size, "random": 0})
+    actions = np.random.default_rng(0).integers(5, size=steps)
+    env.reset()
+    start = time.perf_counter()
+    for action in actions:
+        if env.step(action).last():
+            env.reset()
+    rate = steps / (time.perf_counter() - start)
+    env.task.close()
+    return rate
+
+
+def bench_gymnasium(size: int, steps: int) -> float:
+    env = gymnasium.make("mjmaze/Labyrinth-v0", size=size)
+    actions = np.random.default_rng(0).integers(5, size=steps).tolist()
+    env.reset(seed=0)
+    start = time.perf_counter()
+    for action in actions:
+        _, _, terminated, truncated, _ = env.step(action)
+        if terminated or truncated:
+            env.reset()
+    rate = steps / (time.perf_counter() - start)
+    env.close()
+    return rate
+
+
+def phase_split(size: int, steps: int) -> dict[str, float]:
+    """Microseconds per agent step in each phase of the dm_control step."""
+    env = mjmaze.load("labyrinth", task_kwargs={"size": size, "random": 0})
+    env.reset()
+    task, physics = env.task, env.physics
+    actions = np.random.default_rng(0).integers(5, size=steps)
+    totals = dict.fromkeys(("before_step (action -> velocity)", "physics.step (4 tics)", "after_step (rules)",
+                            "get_observation (render + copy)"), 0.0)
+    keys = list(totals)
+    clock = time.perf_counter
+    for action in actions:
+        t0 = clock()
+        task.before_step(action, physics)
+        t1 = clock()
+        physics.step(4)
+        t2 = clock()
+        task.after_step(physics)
+        t3 = clock()
+        task.get_observation(physics)
+        t4 = clock()
+        for key, dt in zip(keys, (t1 - t0, t2 - t1, t3 - t2, t4 - t3)):
+            totals[key] += dt
+        if task.get_termination(physics) is not None:
+            env.reset()
+    env.task.close()
+    return {key: 1e6 * value / steps for key, value in totals.items()}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--size", type=int, default=9)
+    parser.add_argument("--steps", type=int, default=3000)
+    parser.add_argument("--rounds", type=int, default=5)
+    args = parser.parse_args()
+
+    sides = {"render": bench_render, "raw": bench_raw, "dm_control": bench_dm_control, "gymnasium": bench_gymnasium}
+    rates: dict[str, list[float]] = {name: [] for name in sides}
+    for _ in range(args.rounds):
+        for name, bench in sides.items():
+            rates[name].append(bench(args.size, args.steps))
+    median = {name: statistics.median(values) for name, values in rates.items()}
+
+    print(f"Labyrinth {args.size}x{args.size}, one process, GL backend {render.gl_backend()}, "
+          f"{args.rounds} rounds x {args.steps} steps (median, min-max)")
+    for name, values in rates.items():
+        print(f"  {name:<11} {median[name]:8.0f} obs/s   ({min(values):.0f}-{max(values):.0f})")
+    print(f"  ratio dm_control / raw : {median['dm_control'] / median['raw']:.2f}")
+    print(f"  ratio gymnasium / raw  : {median['gymnasium'] / median['raw']:.2f}")
+    print("  full step by phase (us per agent step):")
+    for key, value in phase_split(args.size, args.steps).items():
+        print(f"    {key:<34} {value:6.1f}")
+
+
+if __name__ == "__main__":
+    main()
