@@ -9,6 +9,7 @@ time limit live here, once.
 
 from __future__ import annotations
 
+import abc
 import collections
 import math
 from collections.abc import Sequence
@@ -158,17 +159,17 @@ class MazeTask(base.Task):
 
     # -- scenario hooks --------------------------------------------------
 
+    @abc.abstractmethod
     def start_episode(self, physics: MazePhysics, config: configs.MazeConfig) -> None:
         """Places the scenario's objects and resets its state."""
-        raise NotImplementedError
 
+    @abc.abstractmethod
     def scenario_step(self, physics: MazePhysics, x: float, y: float) -> tuple[float, bool]:
         """Applies the rules after one agent step at ``(x, y)``: ``(reward, episode ends)``."""
-        raise NotImplementedError
 
+    @abc.abstractmethod
     def metrics(self) -> dict:
         """The scenario's metric fields for ``info``."""
-        raise NotImplementedError
 
     # -- the per-step path ------------------------------------------------
 
