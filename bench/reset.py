@@ -28,6 +28,17 @@ def rss_mb() -> float:
         return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2**20
 
 
+def compile_arena(xml: str, size: int, config: configs.MazeConfig):
+    """A freshly compiled model with ``config``'s walls and its own render context."""
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(model)
+    walls = mjcf.WallLayout(model, size, labyrinth.CELL_SIZE)
+    walls.apply(config.h_walls, config.v_walls)
+    renderer = render.EgoRenderer(model, "ego", 112, 64)
+    renderer.upload_mesh(walls.mesh_id)
+    return model, data, renderer
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--size", type=int, default=9)
@@ -52,13 +63,7 @@ def main() -> None:
     start = time.perf_counter()
     cache = []
     for i in range(n):
-        model = mujoco.MjModel.from_xml_string(xml)
-        data = mujoco.MjData(model)
-        walls = mjcf.WallLayout(model, size, labyrinth.CELL_SIZE)
-        walls.apply(config_set[i].h_walls, config_set[i].v_walls)
-        renderer = render.EgoRenderer(model, "ego", 112, 64)
-        renderer.upload_mesh(walls.mesh_id)
-        cache.append((model, data, renderer))
+        cache.append(compile_arena(xml, size, config_set[i]))
     build_ms = 1e3 * (time.perf_counter() - start) / n
     cache_mb = rss_mb() - before
     start = time.perf_counter()
@@ -72,12 +77,7 @@ def main() -> None:
     before = rss_mb()
     start = time.perf_counter()
     for i in range(n):
-        model = mujoco.MjModel.from_xml_string(xml)
-        data = mujoco.MjData(model)
-        walls = mjcf.WallLayout(model, size, labyrinth.CELL_SIZE)
-        walls.apply(config_set[i].h_walls, config_set[i].v_walls)
-        renderer = render.EgoRenderer(model, "ego", 112, 64)
-        renderer.upload_mesh(walls.mesh_id)
+        model, data, renderer = compile_arena(xml, size, config_set[i])
         mujoco.mj_forward(model, data)
         renderer.close()
     reload_ms = 1e3 * (time.perf_counter() - start) / n
