@@ -33,8 +33,10 @@ _SIDE_CORNERS = ((0, 1), (1, 2), (2, 3), (3, 0))
 class ObjectGeom:
     """A scenario object added to the arena (an item, a pillar, the totem).
 
-    Objects are world geoms placed per episode by writing ``model.geom_pos``;
-    ``z`` is the height of the geom's centre.
+    Each object is a geom in a mocap body of the same name, placed per episode
+    by writing ``data.mocap_pos`` (a body of its own, because MuJoCo's midphase
+    keeps a body's geom bounds from compile time: a colliding world geom could
+    not move). ``z`` is the height of the geom's centre. Objects start hidden.
     """
 
     name: str
@@ -104,13 +106,11 @@ def build_xml(grid_size: int, cell_size: float, objects: Sequence[ObjectGeom] = 
             size=f"{hx} {hy} {WALL_HEIGHT / 2}", pos=f"{x} {y} {WALL_HEIGHT / 2}",
         )
     for obj in objects:
-        attrs = dict(
-            name=obj.name, type=obj.type, size=" ".join(map(str, obj.size)),
-            rgba=" ".join(map(str, obj.rgba)), pos=f"0 0 {obj.z}",
-        )
+        body = ET.SubElement(worldbody, "body", name=obj.name, mocap="true", pos=f"0 0 {obj.z}")
+        attrs = dict(name=obj.name, type=obj.type, size=" ".join(map(str, obj.size)), rgba=" ".join(map(str, obj.rgba)))
         if obj.collides:
             attrs.update(contype="1", conaffinity="1")
-        ET.SubElement(worldbody, "geom", **{"class": "item"}, **attrs)
+        ET.SubElement(body, "geom", **{"class": "item"}, **attrs)
     return ET.tostring(root, encoding="unicode")
 
 

@@ -184,7 +184,13 @@ class EgoRenderer:
         mujoco.mjr_uploadMesh(self._model, self._context, mesh_id)
 
     def render(self, data: mujoco.MjData) -> np.ndarray:
-        """Renders the current state; the result is a view into a reused buffer."""
+        """Renders the current state; the result is a view into a reused buffer.
+
+        Positions are brought up to date first: after ``mj_step`` they lag
+        ``qpos`` by one tic, and objects may have just been moved.
+        """
+        mujoco.mj_kinematics(self._model, data)
+        mujoco.mj_camlight(self._model, data)
         mujoco.mjv_updateScene(self._model, data, self._option, self._perturb, self._camera, self._catmask, self._scene)
         mujoco.mjr_setBuffer(self._offscreen, self._context)
         mujoco.mjr_render(self._viewport, self._scene, self._context)

@@ -35,6 +35,7 @@ AGENT_RADIUS = 0.125
 
 DEFAULT_WIDTH, DEFAULT_HEIGHT = 112, 64
 CAMERA = "ego"
+VISIBLE_GROUP = 1
 
 # (forward, turn) per action; turn +1 is to the left (counter-clockwise).
 ACTION_SETS = {
@@ -59,12 +60,23 @@ class MazePhysics(mujoco.Physics):
         self.data.qpos[:3] = (x, y, yaw)
         self.data.qvel[:3] = 0.0
 
-    def geom_id(self, name: str) -> int:
-        return mj.mj_name2id(self.model.ptr, mj.mjtObj.mjOBJ_GEOM, name)
+    def object_ids(self, names: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
+        """``(mocap ids, geom ids)`` of scenario objects (see :class:`mjmaze.mjcf.ObjectGeom`)."""
+        model = self.model.ptr
+        bodies = [mj.mj_name2id(model, mj.mjtObj.mjOBJ_BODY, name) for name in names]
+        geoms = [mj.mj_name2id(model, mj.mjtObj.mjOBJ_GEOM, name) for name in names]
+        return model.body_mocapid[bodies].copy(), np.array(geoms, dtype=int)
 
-    def place_geom(self, geom_id: int, x: float, y: float) -> None:
-        """Moves a world geom (an object) to ``(x, y)``; takes effect at the next forward."""
-        self.model.geom_pos[geom_id, :2] = (x, y)
+    def place_objects(self, mocap_ids, xy) -> None:
+        """Moves objects to floor positions ``xy`` (shape ``(n, 2)`` or ``(2,)``)."""
+        self.data.ptr.mocap_pos[mocap_ids, :2] = xy
+
+    def show_objects(self, geom_ids, visible) -> None:
+        """Shows (True) or hides (False) objects in the agent's view."""
+        self.model.ptr.geom_group[geom_ids] = np.where(visible, VISIBLE_GROUP, render.HIDDEN_GROUP)
+
+    def set_object_rgba(self, geom_id: int, rgba) -> None:
+        self.model.ptr.geom_rgba[geom_id] = rgba
 
 
 class MazeTask(base.Task):
@@ -109,6 +121,7 @@ class MazeTask(base.Task):
         self._config_in_model: configs.MazeConfig | None = None
         self._steps = 0
         self._reward = 0.0
+        self._return = 0.0
         self._ended = False
 
     # -- configuration and episode start ---------------------------------
@@ -147,7 +160,7 @@ class MazeTask(base.Task):
             self._renderer.upload_mesh(self._walls.mesh_id)
             self._config_in_model = config
         self.config = config
-        self._steps, self._reward, self._ended = 0, 0.0, False
+        self._steps, self._reward, self._return, self._ended = 0, 0.0, 0.0, False
         x, y, yaw = self.spawn_pose(config)
         physics.set_agent_pose(x, y, yaw)
         self.start_episode(physics, config)
@@ -188,6 +201,7 @@ class MazeTask(base.Task):
     def after_step(self, physics: MazePhysics) -> None:
         self._steps += 1
         self._reward, self._ended = self.scenario_step(physics, self._qpos[0], self._qpos[1])
+        self._return += self._reward
 
     def get_observation(self, physics: MazePhysics) -> collections.OrderedDict:
         self._bind(physics)
@@ -228,7 +242,10 @@ class MazeTask(base.Task):
         """Metric fields, the agent's pose and where the episode stands."""
         x, y, yaw = physics.agent_pose()
         info = self.metrics()
-        info.update(x=x, y=y, yaw=yaw, step=self._steps, config_index=self.config.index if self.config else -1)
+        info.update(
+            x=x, y=y, yaw=yaw, step=self._steps, episode_return=self._return,
+            config_index=self.config.index if self.config else -1,
+        )
         return info
 
     def close(self) -> None:

@@ -48,7 +48,9 @@ class Labyrinth(base.MazeTask):
 
     def start_episode(self, physics: base.MazePhysics, config: configs.MazeConfig) -> None:
         self._exit_xy = config.cell_centre(config.object_cells[0])
-        physics.place_geom(physics.geom_id(EXIT.name), *self._exit_xy)
+        mocap_ids, geom_ids = physics.object_ids([EXIT.name])
+        physics.place_objects(mocap_ids, self._exit_xy)
+        physics.show_objects(geom_ids, True)
         self._success = False
 
     def scenario_step(self, physics: base.MazePhysics, x: float, y: float) -> tuple[float, bool]:
