@@ -24,7 +24,12 @@ __all__ = ["ALL_TASKS", "GYM_IDS", "load", "task_kwarg_names"]
 __version__ = "0.1.0"
 
 # scenario -> gymnasium id
-GYM_IDS = {"labyrinth": "mjmaze/Labyrinth-v0"}
+GYM_IDS = {
+    "labyrinth": "mjmaze/Labyrinth-v0",
+    "find_return": "mjmaze/FindReturn-v0",
+    "k_item": "mjmaze/KItem-v0",
+    "two_colour": "mjmaze/TwoColour-v0",
+}
 
 for _scenario, _env_id in GYM_IDS.items():
     if _env_id not in gymnasium.registry:

@@ -6,25 +6,25 @@ import inspect
 
 from dm_control.rl import control
 
-from mjmaze.tasks import base, labyrinth
+from mjmaze.tasks import base, find_return, k_item, labyrinth, two_colour
 
-# name -> factory returning a dm_control Environment.
+# name -> task class; every task is built by mjmaze.tasks.base.make_environment.
 _TASKS = {
-    "labyrinth": labyrinth.labyrinth,
+    "labyrinth": labyrinth.Labyrinth,
+    "find_return": find_return.FindReturn,
+    "k_item": k_item.KItem,
+    "two_colour": two_colour.TwoColour,
 }
 ALL_TASKS = tuple(_TASKS)
 
-# Arguments every task takes (see mjmaze.tasks.base.MazeTask).
-_COMMON_KWARGS = tuple(
-    p for p in inspect.signature(base.MazeTask.__init__).parameters if p not in ("self", "difficulty", "layout")
-)
+
+def _parameters(function, skip=("self", "kwargs", "difficulty", "layout")) -> tuple[str, ...]:
+    return tuple(p for p in inspect.signature(function).parameters if p not in skip)
 
 
 def task_kwarg_names(name: str) -> tuple[str, ...]:
-    """The task arguments ``name`` accepts."""
-    factory = _TASKS[_check_name(name)]
-    own = tuple(p for p in inspect.signature(factory).parameters if p not in ("environment_kwargs", "task_kwargs"))
-    return own + _COMMON_KWARGS
+    """The task arguments scenario ``name`` accepts."""
+    return _parameters(_TASKS[_check_name(name)].__init__) + _parameters(base.MazeTask.__init__)
 
 
 def load(name: str, task_kwargs: dict | None = None, environment_kwargs: dict | None = None) -> control.Environment:
@@ -44,7 +44,7 @@ def load(name: str, task_kwargs: dict | None = None, environment_kwargs: dict | 
     unknown = sorted(set(task_kwargs) - set(valid))
     if unknown:
         raise ValueError(f"unknown task argument(s) {unknown} for {name!r}; valid: {valid}")
-    return _TASKS[name](environment_kwargs=environment_kwargs, **task_kwargs)
+    return base.make_environment(_TASKS[name](**task_kwargs), environment_kwargs)
 
 
 def _check_name(name: str) -> str:

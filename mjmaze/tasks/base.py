@@ -12,6 +12,7 @@ from __future__ import annotations
 import abc
 import collections
 import math
+import os
 from collections.abc import Sequence
 
 import mujoco as mj
@@ -22,6 +23,7 @@ from dm_control.suite import base
 from dm_env import specs
 
 from mjmaze import configs, mjcf, render
+from mjmaze import layouts as layout_files
 
 # Timing: one physics step is one Doom tic; the agent acts every 4 tics.
 TICS_PER_STEP = 4
@@ -98,6 +100,7 @@ class MazeTask(base.Task):
         action_set: str = "default",
         width: int = DEFAULT_WIDTH,
         height: int = DEFAULT_HEIGHT,
+        layouts: str | os.PathLike | None = None,
         random=None,
     ):
         super().__init__(random=random)
@@ -108,7 +111,10 @@ class MazeTask(base.Task):
             if not isinstance(value, (int, np.integer)) or not 16 <= value <= 1024:
                 raise ValueError(f"{name} must be an integer in 16..1024, got {value!r}")
         self.layout = layout
-        self.configs = configs.ConfigSet(self.scenario, difficulty, split, layout, num_configs)
+        if layouts is None:
+            self.configs = configs.ConfigSet(self.scenario, difficulty, split, layout, num_configs)
+        else:
+            self.configs = _imported_configs(layouts, self.scenario, layout, num_configs)
         self._config_sampling = config_sampling
         self._first_config = int(first_config)
         self._actions = ACTION_SETS[action_set]
@@ -263,6 +269,25 @@ def make_environment(task: MazeTask, environment_kwargs: dict | None = None) -> 
     kwargs = dict(n_sub_steps=TICS_PER_STEP, legacy_step=False)
     kwargs.update(environment_kwargs or {})
     return control.Environment(physics, task, **kwargs)
+
+
+def _imported_configs(folder, scenario: str, layout: configs.LayoutSpec, num_configs: int | None):
+    """The paper's layouts from ``folder``, checked against the task's grid and object count."""
+    loaded = layout_files.load_folder(folder, scenario)
+    for config in loaded:
+        if config.size != layout.grid_size or len(config.object_cells) != layout.num_objects:
+            raise ValueError(
+                f"layout {config.index} in {folder} is a {config.size}x{config.size} maze with "
+                f"{len(config.object_cells)} object(s); this task wants {layout.grid_size}x{layout.grid_size} "
+                f"with {layout.num_objects}"
+            )
+    return loaded[:num_configs] if num_configs else loaded
+
+
+def within_pickup(xy, x: float, y: float) -> bool:
+    """True if the agent at ``(x, y)`` is within pick-up range of the point ``xy``."""
+    dx, dy = x - xy[0], y - xy[1]
+    return dx * dx + dy * dy < PICKUP_RADIUS * PICKUP_RADIUS
 
 
 def _check_choice(name: str, value, valid: Sequence) -> None:

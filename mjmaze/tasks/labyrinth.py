@@ -19,8 +19,6 @@ Metric
 
 from __future__ import annotations
 
-from dm_control.rl import control
-
 from mjmaze import configs, maze, mjcf
 from mjmaze.tasks import base
 
@@ -54,8 +52,7 @@ class Labyrinth(base.MazeTask):
         self._success = False
 
     def scenario_step(self, physics: base.MazePhysics, x: float, y: float) -> tuple[float, bool]:
-        dx, dy = x - self._exit_xy[0], y - self._exit_xy[1]
-        if dx * dx + dy * dy < base.PICKUP_RADIUS**2:
+        if base.within_pickup(self._exit_xy, x, y):
             self._success = True
             return STEP_REWARD + EXIT_REWARD, True
         return STEP_REWARD, False
@@ -63,7 +60,3 @@ class Labyrinth(base.MazeTask):
     def metrics(self) -> dict:
         return {"success": self._success}
 
-
-def labyrinth(size: int = DEFAULT_SIZE, environment_kwargs: dict | None = None, **task_kwargs) -> control.Environment:
-    """Labyrinth of ``size x size`` cells as a dm_control environment."""
-    return base.make_environment(Labyrinth(size=size, **task_kwargs), environment_kwargs)

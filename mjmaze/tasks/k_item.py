@@ -1,0 +1,98 @@
+"""Ordered K-item: collect K items in a fixed order that is never shown.
+
+Action Space
+    ``DiscreteArray(5)`` (``action_set="extended"``: 8), as in Labyrinth.
+Observation
+    ``pixels``: uint8 RGB ``(64, 112, 3)``.
+Rewards
+    +0.5 for the next item in order; -0.25 for any other item, which ends the
+    episode; -0.0001 per tic (-0.0004 per agent step). The last item pays +0.5
+    once (**decision**: the released implementation paid it twice for K = 4, 6, 8).
+Termination
+    All K collected or a wrong item (discount 0), or 525 agent steps (discount 1).
+Arguments
+    ``num_items`` K (paper: 2, 4, 6, 8; any of 1..8 works), ``size`` (grid, default
+    5; K + 1 cells are needed) and the common task arguments.
+Metric
+    ``item_score`` = items collected in order / K; also ``items_in_order`` and
+    ``episode_return`` (the raw return).
+
+The collection order is item kind 1, then 2, ... by the released files' colour
+codes: green, red, blue, cyan, magenta, yellow, then two greys, which also
+differ in shape (:data:`KINDS`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from mjmaze import configs, maze, mjcf
+from mjmaze.tasks import base
+
+NUM_ITEMS = tuple(range(1, 9))
+PAPER_NUM_ITEMS = (2, 4, 6, 8)
+DEFAULT_NUM_ITEMS = 4
+DEFAULT_SIZE = 5
+SIZES = tuple(range(2, 14))
+CELL_SIZE = 1.25
+NEXT_ITEM_REWARD = 0.5
+WRONG_ITEM_REWARD = -0.25
+STEP_REWARD = -0.0001 * base.TICS_PER_STEP
+ITEM_Z = 0.25
+
+# Item kinds in collection order: (colour code in the released files, geom).
+KINDS = (
+    ("g", mjcf.ObjectGeom("item_green", "box", (0.1, 0.1, 0.1), (0.1, 0.85, 0.1, 1.0), ITEM_Z)),
+    ("r", mjcf.ObjectGeom("item_red", "box", (0.1, 0.1, 0.1), (0.95, 0.1, 0.1, 1.0), ITEM_Z)),
+    ("b", mjcf.ObjectGeom("item_blue", "box", (0.1, 0.1, 0.1), (0.15, 0.25, 1.0, 1.0), ITEM_Z)),
+    ("c", mjcf.ObjectGeom("item_cyan", "box", (0.1, 0.1, 0.1), (0.0, 0.9, 0.9, 1.0), ITEM_Z)),
+    ("m", mjcf.ObjectGeom("item_magenta", "box", (0.1, 0.1, 0.1), (0.9, 0.1, 0.9, 1.0), ITEM_Z)),
+    ("y", mjcf.ObjectGeom("item_yellow", "box", (0.1, 0.1, 0.1), (1.0, 0.9, 0.0, 1.0), ITEM_Z)),
+    ("0.5", mjcf.ObjectGeom("item_grey50", "sphere", (0.12,), (0.5, 0.5, 0.5, 1.0), ITEM_Z)),
+    ("0.75", mjcf.ObjectGeom("item_grey75", "cylinder", (0.07, 0.16), (0.75, 0.75, 0.75, 1.0), ITEM_Z)),
+)
+KIND_OF_CODE = {code: kind for kind, (code, _) in enumerate(KINDS)}
+
+
+class KItem(base.MazeTask):
+    """Collect K items in the fixed order; see the module docstring."""
+
+    scenario = "k_item"
+
+    def __init__(self, num_items: int = DEFAULT_NUM_ITEMS, size: int = DEFAULT_SIZE, **kwargs):
+        base._check_choice("num_items", num_items, NUM_ITEMS)
+        base._check_choice("size", size, SIZES)
+        if num_items + 1 > size * size:
+            raise ValueError(
+                f"num_items={num_items} needs {num_items + 1} distinct cells (the items and the spawn), "
+                f"but a {size}x{size} grid has {size * size}; use a larger size or fewer items"
+            )
+        self.num_items = num_items
+        self.objects = tuple(geom for _, geom in KINDS[:num_items])
+        layout = configs.LayoutSpec(size, CELL_SIZE, maze.DEFAULT_KEEP_PROBABILITY, num_objects=num_items)
+        super().__init__(difficulty=num_items, layout=layout, **kwargs)
+        self._items_xy = np.zeros((num_items, 2))
+        self._next = 0
+
+    def start_episode(self, physics: base.MazePhysics, config: configs.MazeConfig) -> None:
+        # object_cells[k] holds item kind k.
+        self._items_xy = np.array([config.cell_centre(cell) for cell in config.object_cells])
+        self._mocap_ids, self._geom_ids = physics.object_ids([geom.name for geom in self.objects])
+        physics.place_objects(self._mocap_ids, self._items_xy)
+        physics.show_objects(self._geom_ids, True)
+        self._next = 0
+
+    def scenario_step(self, physics: base.MazePhysics, x: float, y: float) -> tuple[float, bool]:
+        # Items left are kinds next..K-1; at most one is in reach (cells are 1.25 m apart).
+        remaining = self._items_xy[self._next :]
+        near = np.flatnonzero(((remaining - (x, y)) ** 2).sum(axis=1) < base.PICKUP_RADIUS**2)
+        if not len(near):
+            return STEP_REWARD, False
+        if near[0] != 0:  # not the next in order
+            return STEP_REWARD + WRONG_ITEM_REWARD, True
+        physics.show_objects(self._geom_ids[self._next], False)
+        self._next += 1
+        return STEP_REWARD + NEXT_ITEM_REWARD, self._next == self.num_items
+
+    def metrics(self) -> dict:
+        return {"items_in_order": self._next, "item_score": self._next / self.num_items}
+

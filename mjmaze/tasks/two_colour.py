@@ -1,0 +1,160 @@
+"""Two-colour correlation: survive by picking up items of the totem's colour.
+
+Action Space
+    ``DiscreteArray(5)`` (``action_set="extended"``: 8), as in Labyrinth.
+Observation
+    ``pixels``: uint8 RGB ``(64, 112, 3)``.
+Rules
+    A tall totem at the maze centre is red or green, 50/50 per episode. 10 green
+    and 10 red items start at random free positions; one more appears every 30
+    tics, colours alternating, with no cap (as released; at most 90 in an
+    episode, a fixed pool of 90 geoms). Health starts at 100 (cap 100): an item
+    of the totem's colour gives +25, the other colour takes 25, and health decays
+    by 1 per agent step (released: 8 every 32 tics).
+Rewards
+    +0.01 per tic survived (+0.04 per agent step) and ``correct_item_reward``
+    (default +1.0) whenever a correct item raises health (so nothing at full
+    health). **Decision**: what the released training code paid; the paper's text
+    says +0.1 per item and "-0.01 per time-step" (read as a typo).
+Termination
+    Health <= 0 (discount 0) or 525 agent steps (discount 1).
+Arguments
+    ``complexity`` c in 0..10 (paper: 1, 3, 5, 7; each interior wall is kept with
+    probability c/10), ``correct_item_reward``, ``item_cap`` (None = no cap, as
+    released) and the common task arguments. The spawn heading is fixed at 0
+    (facing +x), as released; the spawn cell is never the totem's.
+Metric
+    ``duration``: tics survived (max 2100); also ``health`` and ``totem_green``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from mjmaze import configs, mjcf
+from mjmaze.tasks import base
+
+COMPLEXITIES = tuple(range(0, 11))
+PAPER_COMPLEXITIES = (1, 3, 5, 7)
+DEFAULT_COMPLEXITY = 3
+GRID_SIZE = 5
+CELL_SIZE = 2.0
+START_ITEMS_PER_COLOUR = 10
+SPAWN_EVERY_TICS = 30
+POOL_SIZE = 2 * START_ITEMS_PER_COLOUR + (base.EPISODE_STEPS * base.TICS_PER_STEP) // SPAWN_EVERY_TICS  # 90
+START_HEALTH = MAX_HEALTH = 100
+ITEM_HEALTH = 25
+HEALTH_DECAY_PER_STEP = 1
+SURVIVAL_REWARD = 0.01 * base.TICS_PER_STEP
+CORRECT_ITEM_REWARD = 1.0
+# Items are drawn inside a cell, this far from its walls, and this far from the totem.
+ITEM_WALL_CLEARANCE = 0.25
+ITEM_TOTEM_CLEARANCE = 0.4
+
+RED, GREEN = (0.9, 0.1, 0.1, 1.0), (0.1, 0.8, 0.1, 1.0)
+TOTEM_RADIUS, TOTEM_HEIGHT = 0.125, 1.0
+TOTEM = mjcf.ObjectGeom("totem", "cylinder", (TOTEM_RADIUS, TOTEM_HEIGHT / 2), RED, TOTEM_HEIGHT / 2, collides=True)
+ITEM_HALF = 0.09
+ITEMS = tuple(
+    mjcf.ObjectGeom(f"item_{k}", "box", (ITEM_HALF, ITEM_HALF, ITEM_HALF), RED, ITEM_HALF) for k in range(POOL_SIZE)
+)
+
+
+class TwoColour(base.MazeTask):
+    """Pick up items of the totem's colour to stay alive; see the module docstring."""
+
+    scenario = "two_colour"
+    objects = (TOTEM, *ITEMS)
+
+    def __init__(
+        self,
+        complexity: int = DEFAULT_COMPLEXITY,
+        correct_item_reward: float = CORRECT_ITEM_REWARD,
+        item_cap: int | None = None,
+        **kwargs,
+    ):
+        base._check_choice("complexity", complexity, COMPLEXITIES)
+        if item_cap is not None and not 0 <= item_cap <= POOL_SIZE:
+            raise ValueError(f"item_cap must be None (no cap) or in 0..{POOL_SIZE}, got {item_cap!r}")
+        layout = configs.LayoutSpec(GRID_SIZE, CELL_SIZE, complexity / 10, num_objects=1, centre_object=True)
+        super().__init__(difficulty=complexity, layout=layout, **kwargs)
+        self._correct_item_reward = float(correct_item_reward)
+        self._item_cap = POOL_SIZE if item_cap is None else item_cap
+        self.item_xy = np.zeros((POOL_SIZE, 2))
+        self.item_green = np.arange(POOL_SIZE) % 2 == 0  # alternating colours, green first
+        self.item_active = np.zeros(POOL_SIZE, dtype=bool)
+        self.items_spawned = 0
+        self.totem_green = False
+        self.health = START_HEALTH
+
+    def spawn_pose(self, config: configs.MazeConfig) -> tuple[float, float, float]:
+        x, y = config.cell_centre(config.spawn_cell)
+        return x, y, 0.0
+
+    def start_episode(self, physics: base.MazePhysics, config: configs.MazeConfig) -> None:
+        self._physics = physics
+        self._config = config
+        mocap_ids, geom_ids = physics.object_ids([TOTEM.name] + [item.name for item in ITEMS])
+        self._totem_mocap, self._totem_geom = mocap_ids[0], geom_ids[0]
+        self._item_mocap, self._item_geoms = mocap_ids[1:], geom_ids[1:]
+        self._totem_xy = config.cell_centre(config.object_cells[0])
+        self.totem_green = bool(self.random.rand() < 0.5)
+        physics.place_objects(self._totem_mocap, self._totem_xy)
+        physics.set_object_rgba(self._totem_geom, GREEN if self.totem_green else RED)
+        physics.show_objects(self._totem_geom, True)
+        for geom, green in zip(self._item_geoms, self.item_green):
+            physics.set_object_rgba(geom, GREEN if green else RED)
+        physics.show_objects(self._item_geoms, False)
+        self.item_active[:] = False
+        self.items_spawned = 0
+        self.health = START_HEALTH
+        x, y, _ = physics.agent_pose()
+        self._spawn_items_due(0, x, y)
+
+    def _spawn_items_due(self, tics: int, x: float, y: float) -> None:
+        due = min(2 * START_ITEMS_PER_COLOUR + tics // SPAWN_EVERY_TICS, self._item_cap)
+        while self.items_spawned < due:
+            k = self.items_spawned
+            self.item_xy[k] = self._free_position(x, y)
+            self.item_active[k] = True
+            self._physics.place_objects(self._item_mocap[k], self.item_xy[k])
+            self._physics.show_objects(self._item_geoms[k], True)
+            self.items_spawned += 1
+
+    def _free_position(self, x: float, y: float) -> tuple[float, float]:
+        """A random point inside a random cell, clear of walls and the totem, out of the agent's reach."""
+        n, reach = self._config.size, ITEM_WALL_CLEARANCE
+        while True:
+            cx, cy = self._config.cell_centre((self.random.randint(n), self.random.randint(n)))
+            px = cx + self.random.uniform(-CELL_SIZE / 2 + reach, CELL_SIZE / 2 - reach)
+            py = cy + self.random.uniform(-CELL_SIZE / 2 + reach, CELL_SIZE / 2 - reach)
+            clear_of_totem = math.hypot(px - self._totem_xy[0], py - self._totem_xy[1]) > ITEM_TOTEM_CLEARANCE
+            if clear_of_totem and not base.within_pickup((px, py), x, y):
+                return px, py
+
+    def scenario_step(self, physics: base.MazePhysics, x: float, y: float) -> tuple[float, bool]:
+        reward = 0.0
+        near = self.item_active & (((self.item_xy - (x, y)) ** 2).sum(axis=1) < base.PICKUP_RADIUS**2)
+        for k in np.flatnonzero(near):
+            self.item_active[k] = False
+            physics.show_objects(self._item_geoms[k], False)
+            if self.item_green[k] == self.totem_green:
+                raised = min(self.health + ITEM_HEALTH, MAX_HEALTH) > self.health
+                self.health = min(self.health + ITEM_HEALTH, MAX_HEALTH)
+                reward += self._correct_item_reward if raised else 0.0
+            else:
+                self.health -= ITEM_HEALTH
+        self.health -= HEALTH_DECAY_PER_STEP
+        if self.health <= 0:
+            return reward, True
+        self._spawn_items_due(self.steps * base.TICS_PER_STEP, x, y)
+        return reward + SURVIVAL_REWARD, False
+
+    def metrics(self) -> dict:
+        return {
+            "duration": self.steps * base.TICS_PER_STEP,
+            "health": self.health,
+            "totem_green": self.totem_green,
+        }
