@@ -10,7 +10,7 @@ from dm_env import specs
 from gymnasium.utils.env_checker import check_env
 
 import mjmaze
-from mjmaze.tasks import labyrinth
+from mjmaze.tasks import find_return, k_item, labyrinth, two_colour
 
 
 @pytest.fixture(params=mjmaze.ALL_TASKS)
@@ -19,7 +19,7 @@ def task_name(request):
 
 
 def test_all_tasks_lists_every_scenario_with_a_gym_id():
-    assert "labyrinth" in mjmaze.ALL_TASKS
+    assert mjmaze.ALL_TASKS == ("labyrinth", "find_return", "k_item", "two_colour")
     assert set(mjmaze.GYM_IDS) == set(mjmaze.ALL_TASKS)
     for env_id in mjmaze.GYM_IDS.values():
         assert env_id in gymnasium.registry
@@ -108,12 +108,41 @@ def test_labyrinth_success_info_through_gymnasium():
     env.close()
 
 
-@pytest.mark.parametrize("size", labyrinth.SIZES)
-def test_check_env_passes_without_warnings(size):
-    env = gymnasium.make("mjmaze/Labyrinth-v0", size=size, split="train", render_mode="rgb_array")
+PAPER_TABLE = (
+    [("mjmaze/Labyrinth-v0", {"size": n}) for n in labyrinth.SIZES]
+    + [("mjmaze/FindReturn-v0", {"size": n}) for n in find_return.SIZES]
+    + [("mjmaze/KItem-v0", {"num_items": k}) for k in k_item.PAPER_NUM_ITEMS]
+    + [("mjmaze/TwoColour-v0", {"complexity": c}) for c in two_colour.PAPER_COMPLEXITIES]
+)
+
+
+@pytest.mark.parametrize("env_id, kwargs", PAPER_TABLE)
+def test_check_env_passes_without_warnings(env_id, kwargs):
+    env = gymnasium.make(env_id, split="train", render_mode="rgb_array", **kwargs)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         check_env(env.unwrapped, skip_render_check=False)
+    env.close()
+
+
+METRIC_FIELDS = {
+    "labyrinth": {"success"},
+    "find_return": {"success", "target_found"},
+    "k_item": {"items_in_order", "item_score"},
+    "two_colour": {"duration", "health", "totem_green"},
+}
+
+
+def test_info_carries_metrics_and_pose_on_every_step(task_name):
+    env = gymnasium.make(mjmaze.GYM_IDS[task_name])
+    _, info = env.reset(seed=0)
+    expected = METRIC_FIELDS[task_name] | {"x", "y", "yaw", "step", "episode_return", "config_index"}
+    assert set(info) == expected
+    for action in np.random.default_rng(0).integers(5, size=50):
+        *_, terminated, truncated, info = env.step(int(action))
+        assert set(info) == expected
+        if terminated or truncated:
+            env.reset()
     env.close()
 
 
@@ -129,6 +158,12 @@ def test_check_env_passes_without_warnings(size):
         ("labyrinth", {"action_set": "full"}, "('default', 'extended')"),
         ("labyrinth", {"num_configs": 0}, "num_configs"),
         ("labyrinth", {"width": 3}, "width"),
+        ("find_return", {"size": 6}, "(5, 7, 9, 11, 13)"),
+        ("k_item", {"num_items": 0}, "(1, 2, 3, 4, 5, 6, 7, 8)"),
+        ("k_item", {"num_items": 8, "size": 2}, "needs 9 distinct cells"),
+        ("two_colour", {"complexity": 11}, "(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10)"),
+        ("two_colour", {"size": 5}, "complexity"),  # Two-colour has no size: the error lists what it has
+        ("two_colour", {"item_cap": 91}, "item_cap"),
     ],
 )
 def test_bad_input_raises_a_value_error_listing_valid_choices(name, kwargs, expected):

@@ -138,8 +138,8 @@ def test_the_exit_is_visible_when_faced(labyrinth9):
     def exit_pixels(yaw):
         place(env, ex - 0.3, ey, yaw)
         frame = env.task.get_observation(env.physics)["pixels"].astype(float)
-        # Shaded by the headlight, the exit keeps its hue: strong red, no blue.
-        return ((frame[..., 0] > 150) & (frame[..., 2] < 60)).sum()
+        # Shaded by the headlight, the exit keeps its hue: strong blue, little red.
+        return ((frame[..., 2] > 150) & (frame[..., 0] < 60)).sum()
 
     assert exit_pixels(0.0) > 50  # facing it
     assert exit_pixels(math.pi) == 0  # back turned

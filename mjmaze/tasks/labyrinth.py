@@ -28,7 +28,7 @@ CELL_SIZE = 1.0
 EXIT_REWARD = 1.0
 STEP_REWARD = -0.0001 * base.TICS_PER_STEP
 
-EXIT = mjcf.ObjectGeom("exit", "box", (0.12, 0.12, 0.3), (1.0, 0.55, 0.0, 1.0), z=0.3)
+EXIT = mjcf.ObjectGeom("exit", "box", (0.12, 0.12, 0.3), (0.0, 0.6, 1.0, 1.0), z=0.3)
 
 
 class Labyrinth(base.MazeTask):

@@ -1,0 +1,282 @@
+"""Rules of Find-and-return, Ordered K-item and Two-colour, driven by placing the agent."""
+
+import math
+
+import numpy as np
+import pytest
+
+import mjmaze
+from mjmaze.tasks import base, find_return, k_item, two_colour
+
+from conftest import FORWARD, TURN_LEFT, place
+
+STEP = -0.0004
+
+
+def load(name, **kwargs):
+    env = mjmaze.load(name, task_kwargs={"random": 0, **kwargs})
+    env.reset()
+    return env
+
+
+def touch(env, xy, offset=0.2):
+    """Puts the agent ``offset`` m from ``xy`` and takes one turning step (within pick-up range)."""
+    place(env, xy[0] - offset, xy[1], 0.0)
+    return env.step(TURN_LEFT)
+
+
+# -- Find and return ---------------------------------------------------------
+
+
+def test_find_return_spawns_beside_the_green_pillar():
+    env = load("find_return", size=7)
+    green = env.task.config.cell_centre(env.task.config.spawn_cell)
+    x, y, _ = env.physics.agent_pose()
+    assert (x - green[0], y - green[1]) == pytest.approx((-0.25, -0.25))
+
+
+def test_the_return_counts_only_after_the_target():
+    env = load("find_return", size=7)
+    config = env.task.config
+    green, red = config.cell_centre(config.spawn_cell), config.cell_centre(config.object_cells[0])
+    timestep = touch(env, green)  # returning first pays nothing
+    assert timestep.mid() and timestep.reward == pytest.approx(STEP)
+    timestep = touch(env, red)
+    assert timestep.mid() and timestep.reward == pytest.approx(STEP + 0.5)
+    assert env.task.metrics() == {"success": False, "target_found": True}
+    timestep = touch(env, red)  # the target pays once
+    assert timestep.reward == pytest.approx(STEP)
+    timestep = touch(env, green)
+    assert timestep.last() and timestep.discount == 0.0
+    assert timestep.reward == pytest.approx(STEP + 0.5)
+    assert env.task.metrics() == {"success": True, "target_found": True}
+
+
+def test_pillars_block_movement_and_stay_touchable():
+    env = load("find_return", size=7)
+    red = env.task.config.cell_centre(env.task.config.object_cells[0])
+    place(env, red[0] - 0.45, red[1], 0.0)
+    for _ in range(4):
+        timestep = env.step(FORWARD)
+    x = env.physics.agent_pose()[0]
+    # Stopped at its radius + the pillar's (0.25 m), inside the 0.3 m touch range.
+    assert red[0] - x == pytest.approx(0.25, abs=0.03)
+    assert env.task.metrics()["target_found"]
+
+
+# -- Ordered K-item ----------------------------------------------------------
+
+
+def item_positions(env):
+    config = env.task.config
+    return [config.cell_centre(cell) for cell in config.object_cells]
+
+
+def test_right_then_wrong_item_ends_the_episode():
+    env = load("k_item", num_items=4)
+    items = item_positions(env)
+    timestep = touch(env, items[0])
+    assert timestep.mid() and timestep.reward == pytest.approx(STEP + 0.5)
+    timestep = touch(env, items[2])  # kind 3 before kind 2
+    assert timestep.last() and timestep.discount == 0.0
+    assert timestep.reward == pytest.approx(STEP - 0.25)
+    assert env.task.metrics() == {"items_in_order": 1, "item_score": 0.25}
+
+
+@pytest.mark.parametrize("num_items", k_item.PAPER_NUM_ITEMS)
+def test_all_items_in_order_pay_once_each_and_end_the_episode(num_items):
+    env = load("k_item", num_items=num_items)
+    total = 0.0
+    for kind, xy in enumerate(item_positions(env)):
+        timestep = touch(env, xy)
+        total += timestep.reward
+        assert timestep.reward == pytest.approx(STEP + 0.5)
+        assert timestep.last() == (kind == num_items - 1)
+    assert timestep.discount == 0.0
+    assert total == pytest.approx(num_items * (0.5 + STEP))  # the last item pays once
+    info = env.task.get_info(env.physics)
+    assert (info["items_in_order"], info["item_score"]) == (num_items, 1.0)
+    assert info["episode_return"] == pytest.approx(total)
+
+
+def test_a_collected_item_disappears_and_cannot_be_collected_again():
+    env = load("k_item", num_items=2)
+    first = item_positions(env)[0]
+    touch(env, first)
+    place(env, first[0] - 0.5, first[1], 0.0)
+    frame_with_item_gone = env.task.get_observation(env.physics)["pixels"]
+    green = (frame_with_item_gone[..., 1] > 150) & (frame_with_item_gone[..., 0] < 80)
+    assert green.sum() == 0
+    timestep = touch(env, first)
+    assert timestep.mid() and timestep.reward == pytest.approx(STEP)
+
+
+def test_too_many_items_for_the_grid_is_a_clear_error():
+    with pytest.raises(ValueError, match="needs 9 distinct cells"):
+        mjmaze.load("k_item", task_kwargs={"num_items": 8, "size": 2})
+    with pytest.raises(ValueError, match=r"num_items must be one of \(1, 2, 3, 4, 5, 6, 7, 8\)"):
+        mjmaze.load("k_item", task_kwargs={"num_items": 9})
+
+
+def test_item_colours_come_out_distinct_in_rendered_pixels():
+    env = load("k_item", num_items=8)
+    means = []
+    for kind, xy in enumerate(item_positions(env)):
+        place(env, xy[0] - 0.45, xy[1], 0.0)
+        shown = env.task.get_observation(env.physics)["pixels"].astype(float)
+        env.physics.show_objects(env.task._geom_ids[kind], False)
+        hidden = env.task.get_observation(env.physics)["pixels"].astype(float)
+        env.physics.show_objects(env.task._geom_ids[kind], True)
+        mask = np.abs(shown - hidden).sum(axis=-1) > 0
+        assert mask.sum() > 30, f"item kind {kind} barely visible"
+        means.append(shown[mask].mean(axis=0))
+        # Apart from the walls, floor and sky behind it.
+        assert np.linalg.norm(shown[mask].mean(axis=0) - hidden[mask].mean(axis=0)) > 40
+    means = np.array(means)
+    pairwise = np.linalg.norm(means[:, None] - means[None], axis=-1)
+    assert pairwise[~np.eye(8, dtype=bool)].min() > 40, np.round(means)
+
+
+# -- Two-colour correlation --------------------------------------------------
+
+
+def test_totem_colour_is_drawn_per_episode_and_shown():
+    env = mjmaze.load("two_colour", task_kwargs={"complexity": 1, "random": 0})
+    colours = []
+    for _ in range(40):
+        env.reset()
+        colours.append(env.task.totem_green)
+    assert 10 < sum(colours) < 30
+    totem_rgba = env.physics.model.geom_rgba[env.task._totem_geom]
+    assert tuple(totem_rgba) == pytest.approx(two_colour.GREEN if colours[-1] else two_colour.RED)
+
+
+def test_twenty_items_start_and_one_more_every_thirty_tics():
+    env = load("two_colour", complexity=3)
+    task = env.task
+    assert task.item_active.sum() == 20
+    assert task.item_green[:20].sum() == 10
+    counts = []
+    for _ in range(30):
+        env.step(TURN_LEFT)
+        counts.append(task.items_spawned)
+    # Tic 4k after k steps: item 21 at tic 30 (step 8), item 22 at tic 60 (step 15), ...
+    assert counts[6] == 20 and counts[7] == 21 and counts[13] == 21 and counts[14] == 22
+    assert counts[-1] == 20 + (30 * 4) // 30
+    assert list(task.item_green[20:24]) == [True, False, True, False]  # colours alternate
+
+
+def test_no_item_cap_by_default_and_an_optional_cap_of_60():
+    uncapped = load("two_colour", complexity=1)
+    capped = load("two_colour", complexity=1, item_cap=60)
+    for _ in range(300):  # tic 1200: 20 + 40 items due; spinning in place
+        for env in (uncapped, capped):
+            env.task.health = 100  # keep the agent alive
+            env.step(TURN_LEFT)
+    assert uncapped.task.items_spawned == 60
+    for _ in range(100):
+        for env in (uncapped, capped):
+            env.task.health = 100
+            env.step(TURN_LEFT)
+    assert uncapped.task.items_spawned == 20 + (400 * 4) // 30  # 73: no cap
+    assert capped.task.items_spawned == 60
+
+
+def test_pool_covers_a_full_episode():
+    env = load("two_colour", complexity=1)
+    for _ in range(base.EPISODE_STEPS - 1):
+        env.task.health = 100
+        env.step(TURN_LEFT)
+    timestep = env.step(TURN_LEFT)
+    assert timestep.last() and timestep.discount == 1.0
+    assert env.task.items_spawned == two_colour.POOL_SIZE == 90
+    assert env.task.metrics()["duration"] == 2100
+
+
+def test_health_decays_and_reaching_zero_ends_the_episode():
+    env = load("two_colour", complexity=5)
+    for step in range(1, 101):
+        timestep = env.step(TURN_LEFT)  # spinning never touches an item
+        if step < 100:
+            assert timestep.mid() and timestep.reward == pytest.approx(0.04)
+    assert timestep.last() and timestep.discount == 0.0
+    assert timestep.reward == 0.0  # the last step was not survived
+    info = env.task.get_info(env.physics)
+    assert (info["health"], info["duration"]) == (0, 400)
+
+
+def _lone_item(task, green):
+    """An active item of that colour with no other item within 0.7 m (one pick-up at a time)."""
+    for k in np.flatnonzero(task.item_active & (task.item_green == green)):
+        others = np.delete(np.flatnonzero(task.item_active), np.flatnonzero(np.flatnonzero(task.item_active) == k))
+        if (np.linalg.norm(task.item_xy[others] - task.item_xy[k], axis=1) > 0.7).all():
+            return task.item_xy[k]
+    raise AssertionError("no isolated item")
+
+
+def pick(env, green):
+    # Standing on the item: items are 0.25 m clear of walls, so the agent fits there.
+    return touch(env, _lone_item(env.task, green), offset=0.0)
+
+
+def test_correct_item_raises_health_and_pays_wrong_one_costs_health():
+    env = load("two_colour", complexity=1)
+    task = env.task
+    env.step(TURN_LEFT)  # health 99
+    timestep = pick(env, task.totem_green)
+    assert task.health == 100 - 1  # +25 capped at 100, then the step's decay
+    assert timestep.reward == pytest.approx(0.04 + 1.0)
+    timestep = pick(env, not task.totem_green)
+    assert task.health == 99 - 25 - 1
+    assert timestep.reward == pytest.approx(0.04)
+    timestep = pick(env, task.totem_green)
+    assert task.health == 73 + 25 - 1
+    assert timestep.reward == pytest.approx(0.04 + 1.0)
+
+
+def test_no_item_reward_at_full_health_and_the_reward_is_an_argument():
+    env = load("two_colour", complexity=1, correct_item_reward=0.1)
+    task = env.task
+    env.step(TURN_LEFT)
+    task.health = 100
+    timestep = pick(env, task.totem_green)
+    assert timestep.reward == pytest.approx(0.04)  # health could not rise
+    timestep = pick(env, task.totem_green)
+    assert timestep.reward == pytest.approx(0.04 + 0.1)
+
+
+def test_two_colour_spawn_faces_plus_x_and_avoids_the_totem_cell():
+    env = mjmaze.load("two_colour", task_kwargs={"complexity": 7, "random": 0})
+    for _ in range(20):
+        env.reset()
+        config = env.task.config
+        assert config.object_cells[0] == (2, 2)
+        assert config.spawn_cell != (2, 2)
+        assert env.physics.agent_pose()[2] == 0.0
+
+
+def test_totem_blocks_movement():
+    env = load("two_colour", complexity=0)
+    place(env, -0.8, 0.0, 0.0)  # the totem stands at the maze centre
+    for _ in range(5):
+        env.task.health = 100
+        env.step(FORWARD)
+    assert env.physics.agent_pose()[0] == pytest.approx(-0.25, abs=0.03)
+
+
+def test_complexity_out_of_range_is_a_clear_error():
+    for bad in (-1, 11):
+        with pytest.raises(ValueError, match=r"complexity must be one of \(0, 1, 2"):
+            mjmaze.load("two_colour", task_kwargs={"complexity": bad})
+
+
+def test_items_do_not_block_movement():
+    env = load("two_colour", complexity=0)
+    task = env.task
+    task.item_xy[0] = (-0.8, 0.5)
+    env.physics.place_objects(task._item_mocap[0], task.item_xy[0])
+    place(env, -1.4, 0.5, 0.0)
+    for _ in range(4):
+        env.step(FORWARD)
+    assert env.physics.agent_pose()[0] > -0.5
+    assert math.isclose(env.physics.agent_pose()[1], 0.5, abs_tol=1e-6)
