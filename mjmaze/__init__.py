@@ -33,4 +33,9 @@ GYM_IDS = {
 
 for _scenario, _env_id in GYM_IDS.items():
     if _env_id not in gymnasium.registry:
-        gymnasium.register(id=_env_id, entry_point="mjmaze.gym_env:MazeEnv", kwargs={"scenario": _scenario})
+        gymnasium.register(
+            id=_env_id,
+            entry_point="mjmaze.gym_env:MazeEnv",
+            vector_entry_point="mjmaze.vector:MazeVectorEnv",
+            kwargs={"scenario": _scenario},
+        )

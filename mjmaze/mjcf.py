@@ -81,12 +81,6 @@ def build_xml(grid_size: int, cell_size: float, objects: Sequence[ObjectGeom] = 
     asset = root.find("asset")
     segments = wall_segments(grid_size, cell_size)
 
-    half_extent = grid_size * cell_size / 2 + WALL_THICKNESS
-    # Plane grid spacing of one cell: a fine grid makes llvmpipe ~10x slower.
-    ET.SubElement(
-        worldbody, "geom", name="floor", type="plane", material="floor",
-        size=f"{half_extent} {half_extent} {cell_size}",
-    )
     # A placeholder mesh with room for every segment (disjoint unit boxes, so the
     # compiler merges no vertices); apply_walls overwrites it before first use.
     capacity = len(segments)
@@ -98,6 +92,14 @@ def build_xml(grid_size: int, cell_size: float, objects: Sequence[ObjectGeom] = 
         face=" ".join(str(f) for f in faces.ravel()),
     )
     ET.SubElement(worldbody, "geom", name="walls_visual", type="mesh", mesh=WALL_MESH, material="wall")
+    # The floor after the walls: MuJoCo draws geoms in model order, so floor
+    # pixels hidden by walls fail the depth test before any shading.
+    half_extent = grid_size * cell_size / 2 + WALL_THICKNESS
+    # Plane grid spacing of one cell: a fine grid makes llvmpipe ~10x slower.
+    ET.SubElement(
+        worldbody, "geom", name="floor", type="plane", material="floor",
+        size=f"{half_extent} {half_extent} {cell_size}",
+    )
     for k, (x, y, hx, hy) in enumerate(segments):
         ET.SubElement(
             worldbody, "geom", name=f"wall_{k}", **{"class": "wall_collision"},

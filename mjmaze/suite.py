@@ -27,6 +27,16 @@ def task_kwarg_names(name: str) -> tuple[str, ...]:
     return _parameters(_TASKS[_check_name(name)].__init__) + _parameters(base.MazeTask.__init__)
 
 
+def make_task(name: str, task_kwargs: dict | None = None) -> base.MazeTask:
+    """The task of scenario ``name`` alone (no physics, no rendering yet); checks its arguments."""
+    task_kwargs = dict(task_kwargs or {})
+    valid = task_kwarg_names(name)
+    unknown = sorted(set(task_kwargs) - set(valid))
+    if unknown:
+        raise ValueError(f"unknown task argument(s) {unknown} for {name!r}; valid: {valid}")
+    return _TASKS[name](**task_kwargs)
+
+
 def load(name: str, task_kwargs: dict | None = None, environment_kwargs: dict | None = None) -> control.Environment:
     """Returns the dm_control environment of scenario ``name``.
 
@@ -39,12 +49,7 @@ def load(name: str, task_kwargs: dict | None = None, environment_kwargs: dict | 
     Raises:
       ValueError: unknown name or argument, or a value out of range; the message lists what is valid.
     """
-    task_kwargs = dict(task_kwargs or {})
-    valid = task_kwarg_names(name)
-    unknown = sorted(set(task_kwargs) - set(valid))
-    if unknown:
-        raise ValueError(f"unknown task argument(s) {unknown} for {name!r}; valid: {valid}")
-    return base.make_environment(_TASKS[name](**task_kwargs), environment_kwargs)
+    return base.make_environment(make_task(name, task_kwargs), environment_kwargs)
 
 
 def _check_name(name: str) -> str:

@@ -120,6 +120,9 @@ class MazeTask(base.Task):
         self._actions = ACTION_SETS[action_set]
         self._width, self._height = int(width), int(height)
         self._episode = 0
+        #: Where observations go: None = a fresh array per observation; an array
+        #: (e.g. a slot of a vector env's shared memory) = rendered into it.
+        self.observation_buffer: np.ndarray | None = None
         self._renderer: render.EgoRenderer | None = None
         self._walls: mjcf.WallLayout | None = None
         self._bound_data = None
@@ -211,7 +214,11 @@ class MazeTask(base.Task):
 
     def get_observation(self, physics: MazePhysics) -> collections.OrderedDict:
         self._bind(physics)
-        return collections.OrderedDict(pixels=self._renderer.render(self._bound_data).copy())
+        frame = self._renderer.render(self._bound_data)
+        if self.observation_buffer is None:
+            return collections.OrderedDict(pixels=frame.copy())
+        np.copyto(self.observation_buffer, frame)
+        return collections.OrderedDict(pixels=self.observation_buffer)
 
     def get_reward(self, physics: MazePhysics) -> float:
         return self._reward
@@ -243,6 +250,12 @@ class MazeTask(base.Task):
     def steps(self) -> int:
         """Agent steps taken in the current episode."""
         return self._steps
+
+    def info_fields(self) -> dict[str, type]:
+        """Names and Python types of the fields of :meth:`get_info`, known before any episode."""
+        fields = {key: type(value) for key, value in self.metrics().items()}
+        fields.update(x=float, y=float, yaw=float, step=int, episode_return=float, config_index=int)
+        return fields
 
     def get_info(self, physics: MazePhysics) -> dict:
         """Metric fields, the agent's pose and where the episode stands."""

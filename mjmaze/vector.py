@@ -1,0 +1,392 @@
+"""A gymnasium vector env that runs N mjmaze envs in W worker processes.
+
+Each worker steps its share of the envs in turn and renders straight into one
+shared-memory array of observations ``(N, H, W, 3)``; rewards, flags and the
+``info`` fields travel through shared memory too, so a step sends a few bytes
+per worker over a pipe and pickles no frame. Every worker has one GL context
+for all its envs (faster than one per env: see ``bench/gl_contexts.py``).
+
+Reached the standard way::
+
+    envs = gymnasium.make_vec("mjmaze/Labyrinth-v0", num_envs=16,
+                              vectorization_mode="vector_entry_point", size=9)
+
+Autoreset follows gymnasium 1.x: ``autoreset_mode="next_step"`` (the default,
+gymnasium's own default) resets an env on the step *after* it ended, ignoring
+that step's action and returning the first observation with reward 0 and both
+flags false; ``"same_step"`` resets it at once, returns the new episode's first
+observation and puts the last one in ``infos["final_obs"]`` and its info in
+``infos["final_info"]``. ``infos`` is batched the gymnasium way: one array per
+field with a ``_field`` mask.
+
+A worker that dies (killed, GL failure, an exception in a task) makes the call
+raise :class:`WorkerError` naming the worker and its last error; the vector env
+is then closed. ``close()`` always ends the processes and frees the shared
+memory.
+"""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+import multiprocessing.connection
+import os
+import secrets
+import signal
+import sys
+import time
+import traceback
+from multiprocessing import shared_memory
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium.utils import seeding
+from gymnasium.vector import AutoresetMode
+from gymnasium.vector.utils import batch_space
+
+from mjmaze import suite
+
+SHARED_MEMORY_PREFIX = "mjmaze_"
+AUTORESET_MODES = {"next_step": AutoresetMode.NEXT_STEP, "same_step": AutoresetMode.SAME_STEP}
+
+
+class WorkerError(RuntimeError):
+    """A worker process of :class:`MazeVectorEnv` failed; the vector env is closed."""
+
+
+def _array_layout(num_envs: int, frame_shape: tuple[int, ...], scalar_dtype: np.dtype, same_step: bool):
+    """``[(name, shape, dtype)]`` of the arrays that live in shared memory."""
+    layout = [
+        ("obs", (num_envs, *frame_shape), np.dtype(np.uint8)),
+        ("actions", (num_envs,), np.dtype(np.int64)),
+        ("scalars", (num_envs,), scalar_dtype),
+    ]
+    if same_step:
+        layout += [("final_obs", (num_envs, *frame_shape), np.dtype(np.uint8)), ("final_scalars", (num_envs,), scalar_dtype)]
+    return layout
+
+
+def _views(layout, buffer) -> dict[str, np.ndarray]:
+    views, offset = {}, 0
+    for name, shape, dtype in layout:
+        views[name] = np.ndarray(shape, dtype=dtype, buffer=buffer, offset=offset)
+        offset += int(np.prod(shape)) * dtype.itemsize
+        offset = (offset + 63) // 64 * 64  # keep every array cache-line aligned
+    return views
+
+
+def _layout_size(layout) -> int:
+    return sum((int(np.prod(shape)) * dtype.itemsize + 63) // 64 * 64 for _, shape, dtype in layout)
+
+
+def _attach(name: str) -> shared_memory.SharedMemory:
+    """Opens the parent's segment. The parent owns (and unlinks) it: workers share its
+    resource tracker, where a second registration of the name is a no-op."""
+    if sys.version_info >= (3, 13):
+        return shared_memory.SharedMemory(name=name, track=False)
+    return shared_memory.SharedMemory(name=name)
+
+
+def _write_info(columns: dict[str, np.ndarray], slot: int, info: dict) -> None:
+    for key, value in info.items():
+        columns[key][slot] = value
+
+
+def _worker(worker_id, conn, shm_name, layout, env_ids, first_configs, scenario, task_kwargs, same_step):
+    """A worker's loop: build its envs, then answer step / reset / close commands."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
+    segment = _attach(shm_name)
+    arrays = _views(layout, segment.buf)
+    scalars = arrays["scalars"]
+    columns = {name: scalars[name] for name in scalars.dtype.names}
+    final_columns = {name: arrays["final_scalars"][name] for name in scalars.dtype.names} if same_step else None
+    envs = []
+    try:
+        for slot, first in zip(env_ids, first_configs):
+            env = suite.load(scenario, {**task_kwargs, "first_config": first})
+            env.task.observation_buffer = arrays["obs"][slot]
+            envs.append((slot, env))
+        conn.send(None)
+        while True:
+            command, argument = conn.recv()
+            if command == "step":
+                actions = arrays["actions"]
+                for slot, env in envs:
+                    timestep = env.step(actions[slot])
+                    ended = timestep.last()
+                    terminated = ended and timestep.discount == 0.0
+                    columns["reward"][slot] = timestep.reward or 0.0
+                    columns["terminated"][slot] = terminated
+                    columns["truncated"][slot] = ended and not terminated
+                    if ended and same_step:
+                        arrays["final_obs"][slot] = arrays["obs"][slot]
+                        _write_info(final_columns, slot, env.task.get_info(env.physics))
+                        env.reset()
+                    _write_info(columns, slot, env.task.get_info(env.physics))
+            elif command == "reset":
+                for slot, env in envs:
+                    if argument is not None:
+                        env.task.reseed(argument[slot])
+                    env.reset()
+                    columns["reward"][slot] = 0.0
+                    columns["terminated"][slot] = columns["truncated"][slot] = False
+                    _write_info(columns, slot, env.task.get_info(env.physics))
+            elif command == "close":
+                break
+            conn.send(None)
+    except BaseException as error:  # noqa: BLE001 - report anything to the parent, then exit
+        try:
+            conn.send(("error", f"{type(error).__name__}: {error}", traceback.format_exc()))
+        except (OSError, ValueError):
+            pass
+    finally:
+        for _, env in envs:
+            env.task.observation_buffer = None
+            env.task.close()
+        del arrays, scalars, columns, final_columns, envs
+        segment.close()
+        conn.close()
+
+
+class MazeVectorEnv(gym.vector.VectorEnv):
+    """``num_envs`` copies of one mjmaze scenario in ``num_workers`` processes.
+
+    Args:
+      num_envs: how many envs.
+      scenario: one of ``mjmaze.ALL_TASKS``.
+      num_workers: worker processes (default: the usable cores, at most ``num_envs``).
+      autoreset_mode: ``"next_step"`` (default) or ``"same_step"`` (see the module docstring).
+      copy: return a copy of the shared observations (default). ``False`` returns the
+        shared array itself, which the next step overwrites: faster, for a loop
+        that consumes observations at once.
+      timeout: seconds a worker may take to answer before it counts as failed.
+      context: multiprocessing start method ("spawn" is safe with GL; "forkserver" also works).
+      render_mode: None or "rgb_array" (``render()`` returns the current frames).
+      **task_kwargs: the scenario's task arguments (e.g. ``size=9``). Env ``i``
+        cycles through the configurations from its own offset, so the envs
+        cover different mazes at once.
+
+    ``reset(seed=s)`` seeds env ``i`` with ``s + i`` (a list gives each its own):
+    the same seeds give bit-identical batches.
+    """
+
+    def __init__(
+        self,
+        num_envs: int,
+        scenario: str = "labyrinth",
+        num_workers: int | None = None,
+        autoreset_mode: str | AutoresetMode = "next_step",
+        copy: bool = True,
+        timeout: float = 120.0,
+        context: str = "spawn",
+        render_mode: str | None = None,
+        **task_kwargs: Any,
+    ):
+        if not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
+            raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
+        mode = autoreset_mode if isinstance(autoreset_mode, AutoresetMode) else AUTORESET_MODES.get(autoreset_mode)
+        if mode not in AUTORESET_MODES.values():
+            raise ValueError(f"autoreset_mode must be one of {tuple(AUTORESET_MODES)}, got {autoreset_mode!r}")
+        if render_mode not in (None, "rgb_array"):
+            raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
+        usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+        num_workers = min(num_envs, usable if num_workers is None else num_workers)
+        if num_workers < 1:
+            raise ValueError(f"num_workers must be >= 1, got {num_workers}")
+
+        # Checks the arguments here, in this process, and tells shapes and info fields.
+        probe = suite.make_task(scenario, task_kwargs)
+        frame_spec = probe.observation_spec(None)["pixels"]
+        num_actions = probe.action_spec(None).num_values
+        num_configs = len(probe.configs)
+        info_fields = probe.info_fields()
+        first = task_kwargs.pop("first_config", 0)
+
+        self.num_envs = int(num_envs)
+        self.scenario = scenario
+        self.render_mode = render_mode
+        self.autoreset_mode = mode
+        self.metadata = {"autoreset_mode": mode, "render_modes": ["rgb_array"], "render_fps": 35 / 4}
+        self.single_observation_space = gym.spaces.Box(0, 255, frame_spec.shape, np.uint8)
+        self.single_action_space = gym.spaces.Discrete(num_actions)
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        self.closed = False
+        self._copy = copy
+        self._timeout = float(timeout)
+        self._error: WorkerError | None = None
+
+        scalar_dtype = np.dtype(
+            [("reward", np.float64), ("terminated", np.bool_), ("truncated", np.bool_)]
+            + [(name, np.dtype(kind)) for name, kind in info_fields.items()]
+        )
+        self._info_fields = tuple(info_fields)
+        layout = _array_layout(self.num_envs, frame_spec.shape, scalar_dtype, mode == AutoresetMode.SAME_STEP)
+        self._shm = shared_memory.SharedMemory(
+            name=SHARED_MEMORY_PREFIX + secrets.token_hex(8), create=True, size=_layout_size(layout)
+        )
+        self._arrays = _views(layout, self._shm.buf)
+        self._scalars = self._arrays["scalars"]
+
+        ctx = mp.get_context(context)
+        self._worker_envs = [ids.tolist() for ids in np.array_split(np.arange(self.num_envs), num_workers)]
+        self._conns, self._processes = [], []
+        for worker_id, env_ids in enumerate(self._worker_envs):
+            parent_end, child_end = ctx.Pipe()
+            offsets = [(first + i * num_configs // self.num_envs) % num_configs for i in env_ids]
+            process = ctx.Process(
+                target=_worker,
+                name=f"mjmaze-worker-{worker_id}",
+                args=(worker_id, child_end, self._shm.name, layout, env_ids, offsets, scenario, task_kwargs,
+                      mode == AutoresetMode.SAME_STEP),
+                daemon=True,
+            )
+            process.start()
+            child_end.close()
+            self._conns.append(parent_end)
+            self._processes.append(process)
+        try:
+            self._collect()  # every worker has built its envs
+        except WorkerError as error:
+            raise WorkerError(
+                f"{error}\nWorkers are started with {context!r}: a script that makes a vector env must do so "
+                "under `if __name__ == \"__main__\":`, and the worker's own error is printed above."
+            ) from None
+
+    # -- the gymnasium API ------------------------------------------------
+
+    def reset(self, *, seed: int | list[int] | None = None, options: dict | None = None):
+        if seed is None:
+            seeds = None
+        elif isinstance(seed, (int, np.integer)):
+            seeds = [int(seed) + i for i in range(self.num_envs)]
+        else:
+            seeds = [int(s) for s in seed]
+            if len(seeds) != self.num_envs:
+                raise ValueError(f"reset needs one seed per env ({self.num_envs}), got {len(seeds)}")
+        if seed is not None:
+            self._np_random, self._np_random_seed = seeding.np_random(seeds[0])
+        self._send_all("reset", seeds)
+        return self._observations(), self._infos()
+
+    def step(self, actions):
+        self._check_usable()
+        self._arrays["actions"][:] = actions
+        self._send_all("step", None)
+        scalars = self._scalars
+        infos = self._infos()
+        if self.autoreset_mode == AutoresetMode.SAME_STEP:
+            ended = np.flatnonzero(scalars["terminated"] | scalars["truncated"])
+            final_scalars = self._arrays["final_scalars"]
+            for i in ended:
+                final_info = {name: final_scalars[name][i].item() for name in self._info_fields}
+                infos = self._add_info(infos, {"final_obs": self._arrays["final_obs"][i].copy(), "final_info": final_info}, int(i))
+        return (
+            self._observations(),
+            scalars["reward"].copy(),
+            scalars["terminated"].copy(),
+            scalars["truncated"].copy(),
+            infos,
+        )
+
+    def render(self) -> tuple[np.ndarray, ...] | None:
+        if self.render_mode != "rgb_array":
+            return None
+        return tuple(frame.copy() for frame in self._arrays["obs"])
+
+    def close_extras(self, **kwargs: Any) -> None:
+        self._shutdown()
+
+    def __del__(self):
+        if not getattr(self, "closed", True) and hasattr(self, "_conns"):
+            self.close()
+
+    def __repr__(self) -> str:
+        return f"MazeVectorEnv({self.scenario!r}, num_envs={self.num_envs}, num_workers={len(self._processes)})"
+
+    # -- workers ----------------------------------------------------------
+
+    def _observations(self) -> np.ndarray:
+        return self._arrays["obs"].copy() if self._copy else self._arrays["obs"]
+
+    def _infos(self) -> dict:
+        infos = {}
+        everyone = np.ones(self.num_envs, dtype=bool)
+        for name in self._info_fields:
+            infos[name] = self._scalars[name].copy()
+            infos[f"_{name}"] = everyone.copy()
+        return infos
+
+    def _check_usable(self) -> None:
+        if self._error is not None:
+            raise self._error
+        if self.closed:
+            raise WorkerError("this vector env is closed")
+
+    def _send_all(self, command: str, argument) -> None:
+        self._check_usable()
+        for worker_id, conn in enumerate(self._conns):
+            try:
+                conn.send((command, argument))
+            except (BrokenPipeError, ConnectionResetError, OSError):
+                self._fail(worker_id, "its pipe is broken (the process is gone)")
+        self._collect()
+
+    def _collect(self) -> None:
+        """Waits for every worker's answer; a dead, failing or silent worker raises."""
+        pending = dict(enumerate(self._conns))
+        deadline = time.monotonic() + self._timeout
+        while pending:
+            waitables = list(pending.values()) + [self._processes[w].sentinel for w in pending]
+            ready = multiprocessing.connection.wait(waitables, timeout=max(0.0, deadline - time.monotonic()))
+            if not ready:
+                self._fail(min(pending), f"no answer within {self._timeout:.0f} s")
+            for worker_id, conn in list(pending.items()):
+                if conn.poll():
+                    try:
+                        message = conn.recv()
+                    except (EOFError, OSError):
+                        self._fail(worker_id, self._exit_reason(worker_id))
+                    if message is not None:  # ("error", summary, traceback)
+                        self._fail(worker_id, f"{message[1]}\n{message[2]}")
+                    del pending[worker_id]
+                elif not self._processes[worker_id].is_alive():
+                    self._fail(worker_id, self._exit_reason(worker_id))
+
+    def _exit_reason(self, worker_id: int) -> str:
+        process = self._processes[worker_id]
+        process.join(timeout=1.0)
+        code = process.exitcode
+        if code is not None and code < 0:
+            return f"the process was killed by {signal.Signals(-code).name}"
+        return f"the process exited with code {code}"
+
+    def _fail(self, worker_id: int, reason: str) -> None:
+        envs = self._worker_envs[worker_id]
+        self._error = WorkerError(
+            f"mjmaze vector env worker {worker_id} (envs {envs[0]}..{envs[-1]}, pid {self._processes[worker_id].pid}) "
+            f"failed: {reason.strip()}\nThe vector env is closed; make a new one."
+        )
+        self.close()
+        raise self._error
+
+    def _shutdown(self) -> None:
+        for conn, process in zip(self._conns, self._processes):
+            if process.is_alive():
+                try:
+                    conn.send(("close", None))
+                except (OSError, ValueError):
+                    pass
+        for process in self._processes:
+            process.join(timeout=5.0)
+            if process.is_alive():
+                process.kill()
+                process.join(timeout=5.0)
+        for conn in self._conns:
+            conn.close()
+        self._arrays = self._scalars = None
+        try:
+            self._shm.close()
+        except BufferError:  # the caller still holds an uncopied observation; the name goes anyway
+            pass
+        self._shm.unlink()

@@ -1,0 +1,168 @@
+"""The shared-memory vector env: API, autoreset, seeding, failures and clean-up."""
+
+import os
+import signal
+
+import gymnasium
+import numpy as np
+import pytest
+
+import mjmaze
+from mjmaze.vector import SHARED_MEMORY_PREFIX, MazeVectorEnv, WorkerError
+
+TURN_LEFT = 0
+
+
+def our_segments():
+    return {name for name in os.listdir("/dev/shm") if name.startswith(SHARED_MEMORY_PREFIX)}
+
+
+@pytest.fixture(autouse=True)
+def no_leaked_segments():
+    before = our_segments()
+    yield
+    assert our_segments() == before, "shared memory left behind"
+
+
+def test_make_vec_returns_the_shared_memory_vector_env():
+    envs = gymnasium.make_vec("mjmaze/Labyrinth-v0", num_envs=4, vectorization_mode="vector_entry_point", size=5)
+    assert isinstance(envs, MazeVectorEnv)
+    assert envs.observation_space.shape == (4, 64, 112, 3)
+    assert envs.action_space == gymnasium.spaces.MultiDiscrete([5] * 4)
+    obs, infos = envs.reset(seed=0)
+    assert obs.shape == (4, 64, 112, 3) and obs.dtype == np.uint8
+    obs, rewards, terminated, truncated, infos = envs.step(np.full(4, 2))
+    assert rewards.shape == terminated.shape == truncated.shape == (4,)
+    assert infos["x"].shape == (4,) and infos["_x"].all()
+    assert {"success", "yaw", "config_index", "episode_return"} <= set(infos)
+    assert len({frame.tobytes() for frame in obs}) == 4  # four different envs
+    assert envs.metadata["autoreset_mode"] == gymnasium.vector.AutoresetMode.NEXT_STEP
+    envs.close()
+
+
+def test_envs_start_on_different_configurations():
+    envs = MazeVectorEnv(4, "labyrinth", size=5, num_configs=8)
+    _, infos = envs.reset(seed=0)
+    assert sorted(infos["config_index"]) == [0, 2, 4, 6]
+    envs.close()
+
+
+def _run_to_time_limit(envs, num_envs):
+    for step in range(1, 526):
+        obs, rewards, terminated, truncated, infos = envs.step(np.full(num_envs, TURN_LEFT))
+        if step < 525:
+            assert not truncated.any()
+    return obs, rewards, terminated, truncated, infos
+
+
+def test_next_step_autoreset():
+    envs = MazeVectorEnv(2, "labyrinth", size=5, autoreset_mode="next_step")
+    envs.reset(seed=1)
+    obs, rewards, terminated, truncated, infos = _run_to_time_limit(envs, 2)
+    assert truncated.all() and not terminated.any()
+    assert (infos["step"] == 525).all()
+    last_frames = obs.copy()
+    obs, rewards, terminated, truncated, infos = envs.step(np.full(2, 2))  # the action is ignored
+    assert (rewards == 0).all() and not (terminated | truncated).any()
+    assert (infos["step"] == 0).all() and (infos["episode_return"] == 0).all()
+    assert not np.array_equal(obs, last_frames)
+    envs.close()
+
+
+def test_same_step_autoreset_reports_the_final_observation():
+    envs = MazeVectorEnv(2, "labyrinth", size=5, autoreset_mode="same_step")
+    envs.reset(seed=1)
+    for _ in range(524):
+        obs, *_ = envs.step(np.full(2, TURN_LEFT))
+    before_end = obs.copy()
+    obs, rewards, terminated, truncated, infos = envs.step(np.full(2, TURN_LEFT))
+    assert truncated.all()
+    assert (infos["step"] == 0).all()  # already the new episode
+    assert infos["_final_obs"].all() and infos["final_obs"][0].shape == (64, 112, 3)
+    assert (infos["final_info"]["step"] == 525).all()
+    assert not np.array_equal(infos["final_obs"][0], obs[0])  # the final frame, not the new one
+    # One more left turn from the previous frame's view.
+    assert not np.array_equal(infos["final_obs"][0], before_end[0])
+    envs.close()
+
+
+def test_same_seeds_give_bit_identical_batches():
+    def run():
+        envs = MazeVectorEnv(4, "k_item", num_items=2, config_sampling="random")
+        frames = [envs.reset(seed=123)[0]]
+        actions = np.random.default_rng(0).integers(5, size=(40, 4))
+        frames += [envs.step(a)[0] for a in actions]
+        envs.close()
+        return np.stack(frames)
+
+    first, second = run(), run()
+    assert np.array_equal(first, second)
+
+
+def test_each_env_gets_its_own_seed():
+    envs = MazeVectorEnv(2, "labyrinth", size=5, num_configs=1)
+    _, infos = envs.reset(seed=5)  # same maze; the spawn heading comes from each env's seed
+    assert infos["yaw"][0] != infos["yaw"][1]
+    _, again = envs.reset(seed=[6, 5])
+    assert again["yaw"][1] == infos["yaw"][0]
+    envs.close()
+
+
+@pytest.mark.parametrize(
+    "scenario, kwargs",
+    [("find_return", {"size": 5}), ("k_item", {"num_items": 4}), ("two_colour", {"complexity": 3})],
+)
+def test_every_scenario_runs(scenario, kwargs):
+    envs = MazeVectorEnv(2, scenario, **kwargs)
+    envs.reset(seed=0)
+    for _ in range(5):
+        obs, rewards, *_ = envs.step(np.array([2, 3]))
+    assert obs.std() > 0 and np.isfinite(rewards).all()
+    envs.close()
+
+
+def test_a_killed_worker_is_a_clear_error_not_a_hang():
+    envs = MazeVectorEnv(4, "labyrinth", size=5, num_workers=2)
+    envs.reset(seed=0)
+    os.kill(envs._processes[1].pid, signal.SIGKILL)
+    with pytest.raises(WorkerError, match=r"worker 1 .*SIGKILL"):
+        envs.step(np.zeros(4, dtype=int))
+    with pytest.raises(WorkerError, match="worker 1"):  # and it stays an error
+        envs.step(np.zeros(4, dtype=int))
+    assert not any(p.is_alive() for p in envs._processes)
+
+
+def test_an_exception_in_a_task_names_the_worker_and_the_error():
+    envs = MazeVectorEnv(2, "labyrinth", size=5, num_workers=2)
+    envs.reset(seed=0)
+    with pytest.raises(WorkerError, match=r"worker 0 .*IndexError"):
+        envs.step(np.array([7, 0]))  # no action 7 in the default set of 5
+    assert not any(p.is_alive() for p in envs._processes)
+
+
+def test_a_gl_failure_in_the_workers_is_reported(monkeypatch):
+    monkeypatch.delenv("MUJOCO_GL", raising=False)
+    monkeypatch.setenv("MUJOCO_EGL_DEVICE_ID", "99")  # EGL is chosen, then cannot start
+    envs = MazeVectorEnv(2, "labyrinth", size=5)
+    with pytest.raises(WorkerError, match="GLBackendError"):
+        envs.reset(seed=0)
+
+
+def test_close_ends_the_workers_and_frees_shared_memory():
+    envs = MazeVectorEnv(2, "labyrinth", size=5, copy=False)
+    obs, _ = envs.reset(seed=0)  # an uncopied view of shared memory is still held here
+    processes = list(envs._processes)
+    envs.close()
+    assert not any(p.is_alive() for p in processes)
+    envs.close()  # twice is fine
+    with pytest.raises(WorkerError, match="closed"):
+        envs.step(np.zeros(2, dtype=int))
+
+
+def test_bad_arguments_fail_in_the_calling_process():
+    with pytest.raises(ValueError, match=r"\(5, 7, 9, 11, 13\)"):
+        MazeVectorEnv(2, "labyrinth", size=4)
+    with pytest.raises(ValueError, match="autoreset_mode"):
+        MazeVectorEnv(2, "labyrinth", autoreset_mode="disabled")
+    with pytest.raises(ValueError, match="unknown scenario"):
+        MazeVectorEnv(2, "doom")
