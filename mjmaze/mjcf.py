@@ -150,6 +150,7 @@ class WallLayout:
 
     def __init__(self, model: mujoco.MjModel, grid_size: int, cell_size: float):
         self._model = model
+        self._cell_size = cell_size
         self._segments = wall_segments(grid_size, cell_size)
         first = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "wall_0")
         self._box_ids = np.arange(first, first + len(self._segments))
@@ -174,18 +175,37 @@ class WallLayout:
         present = np.concatenate([h_walls.ravel(), v_walls.ravel()])
         if present.shape != (len(self._segments),):
             raise ValueError(f"wall arrays do not fit this arena ({len(self._segments)} segments)")
-        kept = self._segments[present]
         # Collision boxes: only the present ones collide.
         ids = self._box_ids
         model.geom_contype[ids] = present
         model.geom_conaffinity[ids] = present
-        # Visual mesh: kept boxes first, the rest degenerate (zero-area faces).
-        verts, faces, normals, face_normals = _box_mesh(kept)
-        self._verts[:] = 0.0
-        self._faces[:] = 0
-        self._face_normals[:] = 0
-        self._normals[:] = 0.0
+        # Visual mesh: one box per straight run of walls, and only as many faces
+        # as they need (mjr_uploadMesh sends mesh_facenum faces): fewer vertices
+        # for the rasteriser, whatever the grid's capacity.
+        verts, faces, normals, face_normals = _box_mesh(wall_runs(h_walls, v_walls, self._cell_size))
         self._verts[: len(verts)] = verts
         self._faces[: len(faces)] = faces
         self._face_normals[: len(face_normals)] = face_normals
         self._normals[: len(normals)] = normals
+        model.mesh_facenum[self.mesh_id] = len(faces)
+
+
+def wall_runs(h_walls: np.ndarray, v_walls: np.ndarray, cell_size: float) -> np.ndarray:
+    """Straight runs of adjacent walls as boxes ``(x, y, half_x, half_y)``."""
+    n = h_walls.shape[1]
+    half, thick = (n - 1) / 2, WALL_THICKNESS / 2
+    boxes = []
+    for line in range(n + 1):
+        for start, stop in _runs(h_walls[line]):  # columns start..stop-1 on horizontal line `line`
+            x0, x1 = (start - 0.5 - half) * cell_size, (stop - 0.5 - half) * cell_size
+            boxes.append(((x0 + x1) / 2, (line - 0.5 - half) * cell_size, (x1 - x0) / 2 + thick, thick))
+        for start, stop in _runs(v_walls[:, line]):  # rows start..stop-1 on vertical line `line`
+            y0, y1 = (start - 0.5 - half) * cell_size, (stop - 0.5 - half) * cell_size
+            boxes.append(((line - 0.5 - half) * cell_size, (y0 + y1) / 2, thick, (y1 - y0) / 2 + thick))
+    return np.array(boxes, dtype=np.float64).reshape(-1, 4)
+
+
+def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
+    """``[(start, stop)]`` of the runs of True in a 1-D boolean array."""
+    edges = np.diff(np.concatenate([[0], flags.astype(np.int8), [0]]))
+    return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)))
