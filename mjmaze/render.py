@@ -13,6 +13,7 @@ flipped view of that buffer (GL images are bottom-up).
 
 from __future__ import annotations
 
+import atexit
 import ctypes
 import os
 import sys
@@ -135,7 +136,20 @@ def gl_context():
     except Exception as error:  # noqa: BLE001 - any failure here means "no usable GL"
         raise GLBackendError(f"The {backend!r} GL backend failed to start: {error}\n" + _install_hint()) from error
     _gl_context, _gl_backend, _gl_pid = context, backend, os.getpid()
+    # Free it before the interpreter tears modules down (mujoco.egl's own atexit
+    # hook, registered earlier, runs after this one and ends the display).
+    atexit.register(_free_gl_context)
     return context
+
+
+def _free_gl_context() -> None:
+    global _gl_context
+    if _gl_context is not None and _gl_pid == os.getpid():
+        try:
+            _gl_context.free()
+        except Exception:  # noqa: BLE001 - best effort at exit
+            pass
+    _gl_context = None
 
 
 def gl_backend() -> str | None:
