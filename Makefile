@@ -17,6 +17,7 @@ test: system-deps $(VENV)/.stamp-dev
 
 bench: system-deps $(VENV)/.stamp-bench
 	$(PY) bench/speed.py
+	$(PY) bench/multiproc.py
 
 setup: system-deps $(VENV)/.stamp-all
 
