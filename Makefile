@@ -6,20 +6,28 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 # EGL (default) and OSMesa (fallback) for headless rendering.
 GL_PACKAGES := libegl1 libgl1 libgl1-mesa-dri libegl-mesa0 libglx-mesa0 libosmesa6
+# Installed only when no torch is there yet: install your own (a CUDA build,
+# say) into .venv first to train on a GPU.
+TORCH ?= torch==2.13.0
+# The main job: A2C on Labyrinth 5x5, sized to finish within ~15 minutes on 2 CPU cores.
+RUN_STEPS ?= 1000000
+RUN_NAME ?= labyrinth5_$(shell date +%Y%m%d-%H%M%S)
 
 .PHONY: run test bench setup system-deps clean
 
-run: system-deps $(VENV)/.stamp-viz
-	$(PY) -m mjmaze.rollout --scenario labyrinth --size 9 --steps 5000
+run: system-deps $(VENV)/.stamp-torch $(VENV)/.stamp-train,viz
+	$(PY) -m train.a2c --scenario labyrinth --size 5 --total-steps $(RUN_STEPS) \
+	  --run-name $(RUN_NAME) --checkpoint-every 250000
+	$(PY) -m train.evaluate runs/$(RUN_NAME)
 
-test: system-deps $(VENV)/.stamp-dev
+test: system-deps $(VENV)/.stamp-torch $(VENV)/.stamp-train,dev
 	$(PY) -m pytest -q
 
 bench: system-deps $(VENV)/.stamp-bench
 	$(PY) bench/speed.py
 	$(PY) bench/multiproc.py
 
-setup: system-deps $(VENV)/.stamp-all
+setup: system-deps $(VENV)/.stamp-torch $(VENV)/.stamp-all
 
 system-deps:
 	@if ! command -v dpkg >/dev/null; then \
@@ -34,6 +42,10 @@ $(VENV)/bin/python:
 	@$(PYTHON) -c 'import sys; sys.exit(sys.version_info < (3, 10))' || { echo "mjmaze needs Python >= 3.10"; exit 1; }
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
+
+$(VENV)/.stamp-torch: | $(VENV)/bin/python
+	$(PY) -c 'import torch' 2>/dev/null || $(PY) -m pip install -q "$(TORCH)"
+	@touch $@
 
 $(VENV)/.stamp-%: pyproject.toml | $(VENV)/bin/python
 	$(PY) -m pip install -q -e ".[$*]"

@@ -1,0 +1,131 @@
+"""The A2C baseline: returns and losses by hand, a smoke run, checkpoints, resume, evaluation."""
+
+import json
+import math
+
+import pytest
+import torch
+
+from train import a2c, checkpoint, evaluate
+from train.model import Agent
+
+
+def test_n_step_returns_match_a_hand_computation():
+    rewards = torch.tensor([[1.0, 0.0], [0.0, 1.0], [2.0, 0.0]])
+    dones = torch.tensor([[0.0, 0.0], [1.0, 0.0], [0.0, 0.0]])  # env 0's episode ends at t = 1
+    returns = a2c.n_step_returns(rewards, dones, last_value=torch.tensor([10.0, 20.0]), gamma=0.5)
+    # env 0: R2 = 2 + .5 * 10 = 7; R1 = 0 (cut at the episode end); R0 = 1 + .5 * 0 = 1
+    # env 1: R2 = 0 + .5 * 20 = 10; R1 = 1 + .5 * 10 = 6; R0 = 0 + .5 * 6 = 3
+    assert returns.tolist() == [[1.0, 3.0], [0.0, 6.0], [7.0, 10.0]]
+
+
+def test_a2c_losses_match_a_hand_computation():
+    logits = torch.tensor([[[0.0, 0.0], [math.log(3.0), 0.0]]])  # probabilities (.5, .5) and (.75, .25)
+    values = torch.tensor([[1.0, 2.0]])
+    returns = torch.tensor([[2.0, 1.0]])  # advantages +1 and -1
+    actions = torch.tensor([[0, 1]])
+    losses = a2c.a2c_losses(logits, values, actions, returns, value_coef=0.5, entropy_coef=0.001)
+    policy = -(1 * math.log(0.5) + -1 * math.log(0.25)) / 2
+    entropy = (math.log(2) - (0.75 * math.log(0.75) + 0.25 * math.log(0.25))) / 2
+    assert losses["policy"].item() == pytest.approx(policy)
+    assert losses["value"].item() == pytest.approx(1.0)
+    assert losses["entropy"].item() == pytest.approx(entropy)
+    assert losses["total"].item() == pytest.approx(policy + 0.5 * 1.0 - 0.001 * entropy)
+
+
+def test_network_shapes_and_initialisation():
+    agent = Agent(5)
+    assert agent.linear[0].in_features == 640  # 16 x 4 x 10 at 64 x 112
+    frames = torch.randint(0, 256, (4, 64, 112, 3), dtype=torch.uint8)
+    logits, value, hidden = agent.step(agent.features(frames), agent.initial_state(4), torch.zeros(4, dtype=torch.bool))
+    assert logits.shape == (4, 5) and value.shape == (4,) and hidden.shape == (4, 128)
+    assert all((p == 0).all() for n, p in agent.named_parameters() if "bias" in n)
+    head = agent.policy.weight  # gain 1: orthonormal rows
+    assert torch.allclose(head @ head.T, torch.eye(5), atol=1e-5)
+    conv = agent.encoder[0].weight.flatten(1)  # gain sqrt(2)
+    assert torch.allclose(conv @ conv.T, 2 * torch.eye(16), atol=1e-4)
+
+
+def test_episode_starts_wipe_the_memory():
+    agent = Agent(5)
+    features = torch.randn(2, 128)
+    hidden = torch.randn(2, 128)
+    _, _, after = agent.step(features, hidden, torch.tensor([True, False]))
+    _, _, fresh = agent.step(features, agent.initial_state(2), torch.tensor([False, False]))
+    assert torch.allclose(after[0], fresh[0]) and not torch.allclose(after[1], fresh[1])
+
+
+def tiny(tmp_path, **overrides):
+    settings = dict(
+        scenario="labyrinth", size=5, total_steps=32, num_envs=2, num_steps=8, runs_dir=str(tmp_path),
+        run_name="tiny", checkpoint_every=16, progress=False, torch_threads=1,
+    )
+    settings.update(overrides)
+    return a2c.Args(**settings)
+
+
+def test_two_update_smoke_run_writes_a_run_folder(tmp_path):
+    run = a2c.train(tiny(tmp_path, total_steps=32))
+    assert json.loads((run / "config.json").read_text())["size"] == 5
+    lines = [json.loads(line) for line in (run / "metrics.jsonl").read_text().splitlines()]
+    assert [line["step"] for line in lines] == [16, 32]
+    assert all(math.isfinite(line["policy_loss"]) and line["sps"] > 0 for line in lines)
+    assert list((run / "tensorboard").iterdir())
+    assert [p.name for p in checkpoint.checkpoints(run / "checkpoints")] == ["step_000000000016.pt", "step_000000000032.pt"]
+
+
+def test_resume_continues_step_count_and_optimizer_state(tmp_path):
+    run = a2c.train(tiny(tmp_path, total_steps=32, keep_checkpoints=1))
+    saved = checkpoint.load(checkpoint.checkpoints(run / "checkpoints")[-1])
+    with pytest.raises(FileExistsError, match="--resume"):
+        a2c.train(tiny(tmp_path, total_steps=64))  # never overwrites a run by accident
+    a2c.train(tiny(tmp_path, total_steps=64, resume=True, keep_checkpoints=1))
+    files = checkpoint.checkpoints(run / "checkpoints")
+    assert [p.name for p in files] == ["step_000000000064.pt"]  # the last one kept
+    resumed = checkpoint.load(files[-1])
+    assert (resumed["step"], resumed["update"]) == (64, 4)
+    steps = [json.loads(line)["step"] for line in (run / "metrics.jsonl").read_text().splitlines()]
+    assert steps == [16, 32, 48, 64]
+    # RMSprop's running averages went on from the saved ones rather than from zero.
+    before = saved["optimizer"]["state"][0]["square_avg"]
+    after = resumed["optimizer"]["state"][0]["square_avg"]
+    assert resumed["optimizer"]["state"][0]["step"] == saved["optimizer"]["state"][0]["step"] + 2
+    assert not torch.equal(before, after)
+
+
+def test_a_corrupt_checkpoint_is_a_clear_error_and_stays_untouched(tmp_path):
+    run = a2c.train(tiny(tmp_path))
+    latest = checkpoint.checkpoints(run / "checkpoints")[-1]
+    latest.write_bytes(b"this is not a checkpoint")
+    with pytest.raises(checkpoint.CheckpointError, match="cannot be read"):
+        a2c.train(tiny(tmp_path, total_steps=64, resume=True))
+    assert latest.read_bytes() == b"this is not a checkpoint"
+    with pytest.raises(SystemExit, match="cannot be read"):  # the CLI says it in one line
+        a2c.main(["--runs-dir", str(tmp_path), "--run-name", "tiny", "--size", "5", "--num-envs", "2",
+                  "--num-steps", "8", "--total-steps", "64", "--resume", "--no-progress"])
+
+
+def test_a_checkpoint_of_another_run_is_refused(tmp_path):
+    run = a2c.train(tiny(tmp_path))
+    latest = checkpoint.checkpoints(run / "checkpoints")[-1]
+    before = latest.read_bytes()
+    with pytest.raises(checkpoint.CheckpointError, match="size: checkpoint 5 vs now 7"):
+        a2c.train(tiny(tmp_path, size=7, total_steps=64, resume=True))
+    assert latest.read_bytes() == before
+
+
+def test_flags_for_another_scenario_are_refused():
+    with pytest.raises(ValueError, match="takes no \\['complexity'\\]"):
+        a2c.Args(scenario="labyrinth", complexity=3).task_kwargs()
+
+
+def test_evaluation_plays_every_configuration_twice(tmp_path, monkeypatch):
+    run = a2c.train(tiny(tmp_path))
+    monkeypatch.setattr(evaluate, "EVAL_CONFIGS", 8)
+    result = evaluate.evaluate(run, num_envs=4)
+    for split in ("train", "test"):
+        assert result[split]["episodes"] == 16
+        assert result[split]["configs"] == sorted(list(range(8)) * 2)  # each exactly twice
+        assert 0.0 <= result[split]["value"] <= 100.0
+    saved = json.loads((run / "eval.json").read_text())
+    assert saved["test"]["episodes"] == 16 and saved["units"] == "success %"

@@ -1,0 +1,308 @@
+"""A2C with a CNN + GRU agent, the paper's baseline, on mjmaze's vector env.
+
+    python -m train.a2c --scenario labyrinth --size 5 --total-steps 2000000
+    python -m train.a2c --scenario k_item --num-items 4 --total-steps 50000000
+    python -m train.a2c --run-name labyrinth_5_s0 --resume        # go on from the last checkpoint
+
+Everything a run writes goes to ``runs/<name>/``: ``config.json``, ``metrics.jsonl``
+(one line per update), TensorBoard events, and ``checkpoints/`` (periodic and
+final, written atomically, the last few kept). Ctrl-C or SIGTERM saves a final
+checkpoint before exiting.
+
+The algorithm, top to bottom in :func:`train`: 16 envs x 128 steps per update;
+the env autoresets in the same step (the returned frame starts the next
+episode, so the GRU memory is wiped there); n-step returns bootstrapped from the
+value of the last frame, cut at every episode end (the time limit included, as
+released); loss = policy + 0.5 * value - 0.001 * entropy; gradient norm clipped
+at 0.5; RMSprop (lr 7e-4, alpha 0.99, eps 1e-8).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import pathlib
+import signal
+import time
+
+import numpy as np
+import torch
+import tyro
+from torch.nn import functional as F
+
+from mjmaze.vector import MazeVectorEnv
+from train import checkpoint
+from train.model import Agent
+
+# The scenario's headline metric in the units of the paper's Table 2: (info field, scale, label).
+PAPER_METRIC = {
+    "labyrinth": ("success", 100.0, "success %"),
+    "find_return": ("success", 100.0, "success %"),
+    "k_item": ("item_score", 1.0, "items in order / K"),
+    "two_colour": ("duration", 1.0, "tics survived"),
+}
+
+
+@dataclasses.dataclass
+class Args:
+    """Train the paper's A2C baseline on one mjmaze scenario."""
+
+    scenario: str = "labyrinth"
+    """labyrinth, find_return, k_item or two_colour"""
+    size: int | None = None
+    """maze size n (Labyrinth, Find-and-return; K-item's grid); None: the scenario's default"""
+    num_items: int | None = None
+    """K for Ordered K-item"""
+    complexity: int | None = None
+    """complexity c for Two-colour"""
+    num_configs: int | None = None
+    """training configurations (None: 256; the paper's study: 16, 64, 256, 1024)"""
+    total_steps: int = 10_000_000
+    """agent steps to train for, over all envs"""
+    num_envs: int = 16
+    """parallel envs"""
+    num_steps: int = 128
+    """steps per env per update"""
+    gamma: float = 0.99
+    """discount"""
+    lr: float = 7e-4
+    """RMSprop learning rate"""
+    alpha: float = 0.99
+    """RMSprop smoothing constant"""
+    eps: float = 1e-8
+    """RMSprop epsilon (PyTorch's default; the released 1e-5 never reached the optimiser)"""
+    value_coef: float = 0.5
+    """weight of the value loss"""
+    entropy_coef: float = 0.001
+    """weight of the entropy bonus"""
+    max_grad_norm: float = 0.5
+    """gradient norm clip"""
+    seed: int = 0
+    """seed of the envs and the network"""
+    num_workers: int | None = None
+    """env worker processes (None: the usable cores)"""
+    device: str = "auto"
+    """auto (CUDA when available), cpu or cuda"""
+    torch_threads: int | None = None
+    """CPU threads for the network (None: PyTorch's default)"""
+    run_name: str | None = None
+    """folder under runs_dir (None: <scenario>_<difficulty>_s<seed>)"""
+    runs_dir: str = "runs"
+    """where runs live"""
+    checkpoint_every: int = 1_000_000
+    """agent steps between checkpoints"""
+    keep_checkpoints: int = 3
+    """how many checkpoints to keep"""
+    resume: bool = False
+    """go on from the run's last checkpoint (same optimizer state and step count)"""
+    progress: bool = True
+    """show a progress bar"""
+
+    def task_kwargs(self) -> dict:
+        """The scenario's task arguments from these flags."""
+        kwargs = {"size": self.size, "num_items": self.num_items, "complexity": self.complexity}
+        allowed = {"labyrinth": {"size"}, "find_return": {"size"}, "k_item": {"num_items", "size"}, "two_colour": {"complexity"}}
+        if self.scenario not in allowed:
+            raise ValueError(f"unknown scenario {self.scenario!r}; valid: {tuple(allowed)}")
+        extra = {k for k, v in kwargs.items() if v is not None} - allowed[self.scenario]
+        if extra:
+            raise ValueError(f"{self.scenario} takes no {sorted(extra)}; it takes {sorted(allowed[self.scenario])}")
+        kwargs = {k: v for k, v in kwargs.items() if v is not None}
+        if self.num_configs is not None:
+            kwargs["num_configs"] = self.num_configs
+        return kwargs
+
+    def name(self) -> str:
+        if self.run_name:
+            return self.run_name
+        difficulty = self.size or self.num_items or self.complexity or "default"
+        return f"{self.scenario}_{difficulty}_s{self.seed}"
+
+
+def n_step_returns(rewards: torch.Tensor, dones: torch.Tensor, last_value: torch.Tensor, gamma: float) -> torch.Tensor:
+    """Bootstrapped n-step returns: ``R_t = r_t + gamma * (1 - done_t) * R_{t+1}``, ``R_T = V(s_T)``.
+
+    ``rewards`` and ``dones`` are ``(T, B)``; ``done_t`` marks that step ``t`` ended an episode.
+    """
+    returns = torch.empty_like(rewards)
+    running = last_value
+    for t in range(rewards.shape[0] - 1, -1, -1):
+        running = rewards[t] + gamma * running * (1.0 - dones[t])
+        returns[t] = running
+    return returns
+
+
+def a2c_losses(logits: torch.Tensor, values: torch.Tensor, actions: torch.Tensor, returns: torch.Tensor,
+               value_coef: float, entropy_coef: float) -> dict[str, torch.Tensor]:
+    """The A2C loss terms, averaged over all ``(T, B)`` steps."""
+    log_probs = F.log_softmax(logits, dim=-1)
+    action_log_probs = log_probs.gather(-1, actions.unsqueeze(-1)).squeeze(-1)
+    entropy = -(log_probs.exp() * log_probs).sum(-1).mean()
+    advantages = returns - values
+    policy_loss = -(advantages.detach() * action_log_probs).mean()
+    value_loss = advantages.pow(2).mean()
+    total = policy_loss + value_coef * value_loss - entropy_coef * entropy
+    return {"policy": policy_loss, "value": value_loss, "entropy": entropy, "total": total}
+
+
+def pick_device(name: str) -> torch.device:
+    if name == "auto":
+        return torch.device("cuda" if torch.cuda.is_available() else "cpu")
+    return torch.device(name)
+
+
+class _Stop(Exception):
+    """SIGTERM, turned into a clean stop."""
+
+
+def train(args: Args) -> pathlib.Path:
+    """Trains, checkpointing as it goes; returns the run's folder."""
+    task_kwargs = args.task_kwargs()
+    run_dir = pathlib.Path(args.runs_dir) / args.name()
+    checkpoint_dir = run_dir / "checkpoints"
+    config = dataclasses.asdict(args)
+    if run_dir.exists() and checkpoint.checkpoints(checkpoint_dir) and not args.resume:
+        raise FileExistsError(f"{run_dir} already holds a run: pass --resume to go on, or another --run-name")
+    state = None
+    if args.resume:
+        found = checkpoint.checkpoints(checkpoint_dir)
+        if not found:
+            raise FileNotFoundError(f"--resume: no checkpoint in {checkpoint_dir}")
+        state = checkpoint.load(found[-1], config)
+
+    device = pick_device(args.device)
+    if args.torch_threads:
+        torch.set_num_threads(args.torch_threads)
+    torch.manual_seed(args.seed)
+    envs = MazeVectorEnv(
+        args.num_envs, args.scenario, num_workers=args.num_workers, autoreset_mode="same_step", copy=False,
+        split="train", **task_kwargs,
+    )
+    try:
+        agent = Agent(envs.single_action_space.n, envs.single_observation_space.shape).to(device)
+        optimizer = torch.optim.RMSprop(agent.parameters(), lr=args.lr, alpha=args.alpha, eps=args.eps)
+        step, update = 0, 0
+        if state is not None:
+            agent.load_state_dict(state["model"])
+            optimizer.load_state_dict(state["optimizer"])
+            step, update = int(state["step"]), int(state["update"])
+        checkpoint.atomic_write_json(run_dir / "config.json", config)
+        return _loop(args, envs, agent, optimizer, device, run_dir, step, update)
+    finally:
+        envs.close()
+
+
+def _loop(args, envs, agent, optimizer, device, run_dir, step, update) -> pathlib.Path:
+    from torch.utils.tensorboard import SummaryWriter
+    from tqdm import tqdm
+
+    n, T = args.num_envs, args.num_steps
+    metric, scale, _ = PAPER_METRIC[args.scenario]
+    frame_shape = envs.single_observation_space.shape
+    frames = torch.zeros((T, n, *frame_shape), dtype=torch.uint8)
+    starts = torch.zeros((T, n), dtype=torch.bool)
+    actions = torch.zeros((T, n), dtype=torch.long)
+    rewards = torch.zeros((T, n))
+    dones = torch.zeros((T, n))
+
+    obs, _ = envs.reset(seed=args.seed + 1000 * update)
+    hidden = agent.initial_state(n, device)
+    episode_starts = torch.ones(n, dtype=torch.bool)
+    writer = SummaryWriter(run_dir / "tensorboard")
+    metrics_file = open(run_dir / "metrics.jsonl", "a")
+    next_checkpoint = (step // args.checkpoint_every + 1) * args.checkpoint_every
+    bar = tqdm(total=args.total_steps, initial=step, unit="step", disable=not args.progress, dynamic_ncols=True)
+    previous_handler = signal.signal(signal.SIGTERM, _raise_stop)
+    stopped = False
+    try:
+        while step < args.total_steps:
+            start_time = time.perf_counter()
+            first_hidden = hidden.detach()
+            finished = []  # final infos of the episodes that ended in this rollout
+            for t in range(T):
+                frames[t].copy_(torch.from_numpy(obs))
+                starts[t] = episode_starts
+                with torch.no_grad():
+                    features = agent.features(frames[t].to(device))
+                    logits, _, hidden = agent.step(features, hidden, episode_starts.to(device))
+                    action = torch.distributions.Categorical(logits=logits).sample()
+                obs, reward, terminated, truncated, infos = envs.step(action.cpu().numpy())
+                ended = terminated | truncated
+                actions[t] = action.cpu()
+                rewards[t] = torch.from_numpy(reward)
+                dones[t] = torch.from_numpy(ended.astype(np.float32))
+                episode_starts = torch.from_numpy(ended)
+                for i in np.flatnonzero(ended):
+                    finished.append({k: v[i] for k, v in infos["final_info"].items() if not k.startswith("_")})
+            with torch.no_grad():
+                features = agent.features(torch.from_numpy(obs).to(device))
+                _, last_value, _ = agent.step(features, hidden, episode_starts.to(device))
+            returns = n_step_returns(rewards.to(device), dones.to(device), last_value, args.gamma)
+            logits, values, _, _ = agent.unroll(frames.to(device), first_hidden, starts.to(device))
+            losses = a2c_losses(logits, values, actions.to(device), returns, args.value_coef, args.entropy_coef)
+            optimizer.zero_grad()
+            losses["total"].backward()
+            grad_norm = torch.nn.utils.clip_grad_norm_(agent.parameters(), args.max_grad_norm)
+            optimizer.step()
+            hidden = hidden.detach()
+
+            step += n * T
+            update += 1
+            sps = n * T / (time.perf_counter() - start_time)
+            record = {
+                "step": step, "update": update, "sps": sps,
+                "policy_loss": losses["policy"].item(), "value_loss": losses["value"].item(),
+                "entropy": losses["entropy"].item(), "grad_norm": float(grad_norm), "episodes": len(finished),
+            }
+            if finished:
+                record["episode_return"] = float(np.mean([e["episode_return"] for e in finished]))
+                record[metric] = float(np.mean([e[metric] for e in finished])) * scale
+            metrics_file.write(json.dumps(record) + "\n")
+            metrics_file.flush()
+            for key in ("policy_loss", "value_loss", "entropy"):
+                writer.add_scalar(f"losses/{key}", record[key], step)
+            writer.add_scalar("charts/SPS", sps, step)
+            if finished:
+                writer.add_scalar("charts/episode_return", record["episode_return"], step)
+                writer.add_scalar(f"charts/{metric}", record[metric], step)
+            bar.update(n * T)
+            bar.set_postfix(sps=f"{sps:.0f}", **({metric: f"{record[metric]:.3g}"} if finished else {}))
+            if step >= next_checkpoint:
+                _save(args, agent, optimizer, step, update, run_dir)
+                next_checkpoint += args.checkpoint_every
+    except (KeyboardInterrupt, _Stop):
+        stopped = True
+    finally:
+        signal.signal(signal.SIGTERM, previous_handler)
+        bar.close()
+        writer.close()
+        metrics_file.close()
+    path = _save(args, agent, optimizer, step, update, run_dir)
+    print(f"{'stopped' if stopped else 'done'} at step {step:,}; checkpoint {path}")
+    if stopped:
+        raise SystemExit(130)
+    return run_dir
+
+
+def _raise_stop(signum, frame):
+    raise _Stop()
+
+
+def _save(args, agent, optimizer, step, update, run_dir) -> pathlib.Path:
+    state = {
+        "model": agent.state_dict(), "optimizer": optimizer.state_dict(),
+        "step": step, "update": update, "config": dataclasses.asdict(args),
+    }
+    return checkpoint.save(run_dir / "checkpoints", state, step, args.keep_checkpoints)
+
+
+def main(argv: list[str] | None = None) -> None:
+    args = tyro.cli(Args, args=argv)
+    try:
+        train(args)
+    except (checkpoint.CheckpointError, FileExistsError, FileNotFoundError, ValueError) as error:
+        raise SystemExit(f"error: {error}") from None
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,138 @@
+"""Greedy evaluation of a trained run on its training and test configurations.
+
+    python -m train.evaluate runs/labyrinth_5_s0 [--checkpoint PATH] [--num-envs 16]
+
+**Decision** (as in SCENARIOS.md): each of the first 64 test configurations, and
+64 training ones, is played twice to its end or the time limit - 128 episodes
+per split - rather than the released "first 128 episodes to finish", which
+favoured short episodes. Actions are the argmax of the policy. Writes
+``eval.json`` into the run folder (atomically) with each split's metric in the
+units of the paper's Table 2, and prints the table.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import pathlib
+
+import numpy as np
+import torch
+
+from mjmaze import suite
+from mjmaze.vector import MazeVectorEnv
+from train import checkpoint
+from train.a2c import PAPER_METRIC, Args, pick_device
+from train.model import Agent
+
+EVAL_CONFIGS = 64
+PLAYS_PER_CONFIG = 2
+
+
+def play_split(agent: Agent, args: Args, split: str, num_envs: int, device: torch.device, seed: int = 0) -> dict:
+    """Plays each of ``EVAL_CONFIGS`` configurations of ``split`` twice, greedily."""
+    if EVAL_CONFIGS % num_envs:
+        raise ValueError(f"num_envs must divide {EVAL_CONFIGS}, got {num_envs}")
+    # Env i starts at configuration i * 64 / num_envs and cycles, so its first
+    # 2 * 64 / num_envs episodes cover its block and the next: every
+    # configuration exactly twice.
+    per_env = PLAYS_PER_CONFIG * EVAL_CONFIGS // num_envs
+    task_kwargs = {k: v for k, v in args.task_kwargs().items() if k != "num_configs"}
+    envs = MazeVectorEnv(
+        num_envs, args.scenario, autoreset_mode="same_step", copy=False, split=split,
+        num_configs=EVAL_CONFIGS, config_sampling="cycle", **task_kwargs,
+    )
+    metric, scale, _ = PAPER_METRIC[args.scenario]
+    episodes: list[list[dict]] = [[] for _ in range(num_envs)]
+    try:
+        obs, _ = envs.reset(seed=seed)
+        hidden = agent.initial_state(num_envs, device)
+        starts = torch.ones(num_envs, dtype=torch.bool)
+        while min(len(e) for e in episodes) < per_env:
+            with torch.no_grad():
+                features = agent.features(torch.from_numpy(obs).to(device))
+                logits, _, hidden = agent.step(features, hidden, starts.to(device))
+            obs, _, terminated, truncated, infos = envs.step(logits.argmax(-1).cpu().numpy())
+            ended = terminated | truncated
+            starts = torch.from_numpy(ended)
+            for i in np.flatnonzero(ended):
+                if len(episodes[i]) < per_env:
+                    episodes[i].append({k: v[i].item() for k, v in infos["final_info"].items() if not k.startswith("_")})
+    finally:
+        envs.close()
+    played = [e for env_episodes in episodes for e in env_episodes]
+    values = np.array([e[metric] for e in played], dtype=float) * scale
+    return {
+        "metric": metric,
+        "value": float(values.mean()),
+        "std": float(values.std()),
+        "episodes": len(played),
+        "mean_return": float(np.mean([e["episode_return"] for e in played])),
+        "configs": sorted(e["config_index"] for e in played),
+    }
+
+
+def evaluate(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | None = None, num_envs: int = 16,
+             device: str = "auto") -> dict:
+    """Evaluates a run's checkpoint (default: its latest) on train and test; writes ``eval.json``."""
+    run_dir = pathlib.Path(run_dir)
+    config_file = run_dir / "config.json"
+    if not config_file.exists():
+        raise FileNotFoundError(f"{run_dir} is not a training run (no config.json)")
+    args = Args(**json.loads(config_file.read_text()))
+    if checkpoint_path is None:
+        found = checkpoint.checkpoints(run_dir / "checkpoints")
+        if not found:
+            raise FileNotFoundError(f"no checkpoint in {run_dir / 'checkpoints'}")
+        checkpoint_path = found[-1]
+    state = checkpoint.load(pathlib.Path(checkpoint_path), dataclasses.asdict(args))
+    torch_device = pick_device(device)
+    task = suite.make_task(args.scenario, {k: v for k, v in args.task_kwargs().items() if k != "num_configs"})
+    agent = Agent(task.action_spec(None).num_values, task.observation_spec(None)["pixels"].shape).to(torch_device)
+    agent.load_state_dict(state["model"])
+    agent.eval()
+    result = {
+        "run": str(run_dir),
+        "checkpoint": str(checkpoint_path),
+        "step": int(state["step"]),
+        "scenario": args.scenario,
+        "task_kwargs": args.task_kwargs(),
+        "units": PAPER_METRIC[args.scenario][2],
+    }
+    for split in ("train", "test"):
+        result[split] = play_split(agent, args, split, num_envs, torch_device)
+    checkpoint.atomic_write_json(run_dir / "eval.json", result)
+    return result
+
+
+def format_table(result: dict) -> str:
+    units = result["units"]
+    lines = [
+        f"{result['scenario']} {result['task_kwargs']} at step {result['step']:,}",
+        f"| split | {units} | std | episodes | mean return |",
+        "|---|---|---|---|---|",
+    ]
+    for split in ("train", "test"):
+        r = result[split]
+        lines.append(f"| {split} | {r['value']:.3g} | {r['std']:.3g} | {r['episodes']} | {r['mean_return']:.3f} |")
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("run_dir", type=pathlib.Path)
+    parser.add_argument("--checkpoint", type=pathlib.Path, default=None, help="default: the run's latest")
+    parser.add_argument("--num-envs", type=int, default=16, help="parallel envs (must divide 64)")
+    parser.add_argument("--device", default="auto")
+    args = parser.parse_args(argv)
+    try:
+        result = evaluate(args.run_dir, args.checkpoint, args.num_envs, args.device)
+    except (checkpoint.CheckpointError, FileNotFoundError, ValueError) as error:
+        raise SystemExit(f"error: {error}") from None
+    print(format_table(result))
+    print(f"written: {args.run_dir / 'eval.json'}")
+
+
+if __name__ == "__main__":
+    main()
