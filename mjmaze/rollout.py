@@ -1,7 +1,7 @@
-"""Random-policy rollout: ``python -m mjmaze.rollout --size 9 --steps 5000``.
+"""Random-policy rollout: ``python -m mjmaze.rollout --scenario labyrinth --size 9 --steps 5000``.
 
-Prints episodes, success rate and obs/s, and writes a strip of frames as a PNG
-(the main job of ``make run`` until the baseline agent lands).
+Prints episodes, the scenario's metrics (mean over finished episodes) and obs/s,
+and writes a strip of frames as a PNG.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ def rollout(scenario: str, steps: int, seed: int, strip_frames: int, **task_kwar
     env = mjmaze.load(scenario, task_kwargs={"random": seed, **task_kwargs})
     rng = np.random.default_rng(seed)
     num_actions = env.action_spec().num_values
-    frames, successes, returns, episode_return = [], [], [], 0.0
+    frames, metrics, returns, episode_return = [], [], [], 0.0
     keep_every = max(1, steps // strip_frames)
     timestep = env.reset()
     start = time.perf_counter()
@@ -31,15 +31,15 @@ def rollout(scenario: str, steps: int, seed: int, strip_frames: int, **task_kwar
         if step % keep_every == 0 and len(frames) < strip_frames:
             frames.append(timestep.observation["pixels"])
         if timestep.last():
-            successes.append(env.task.metrics()["success"])
+            metrics.append(env.task.metrics())
             returns.append(episode_return)
             episode_return = 0.0
             env.reset()
     elapsed = time.perf_counter() - start
     env.task.close()
     return {
-        "episodes": len(successes),
-        "success_rate": float(np.mean(successes)) if successes else 0.0,
+        "episodes": len(metrics),
+        "metrics": {key: float(np.mean([m[key] for m in metrics])) for key in (metrics[0] if metrics else {})},
         "mean_return": float(np.mean(returns)) if returns else 0.0,
         "obs_per_s": steps / elapsed,
         "frames": frames,
@@ -49,7 +49,9 @@ def rollout(scenario: str, steps: int, seed: int, strip_frames: int, **task_kwar
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--scenario", default="labyrinth", choices=mjmaze.ALL_TASKS)
-    parser.add_argument("--size", type=int, default=9, help="maze size n (n x n cells)")
+    parser.add_argument("--size", type=int, default=None, help="maze size n (Labyrinth, Find-and-return, K-item grid)")
+    parser.add_argument("--num-items", type=int, default=None, help="K (Ordered K-item)")
+    parser.add_argument("--complexity", type=int, default=None, help="c (Two-colour)")
     parser.add_argument("--split", default="train", choices=("train", "test"))
     parser.add_argument("--steps", type=int, default=5000, help="agent steps to run")
     parser.add_argument("--seed", type=int, default=0)
@@ -57,10 +59,15 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("runs/rollout/frames.png"))
     args = parser.parse_args(argv)
 
-    result = rollout(args.scenario, args.steps, args.seed, args.strip_frames, size=args.size, split=args.split)
-    print(f"{args.scenario} {args.size}x{args.size} ({args.split}), random policy, {args.steps} agent steps")
+    difficulty = {
+        key: value for key, value in (("size", args.size), ("num_items", args.num_items), ("complexity", args.complexity))
+        if value is not None
+    }
+    result = rollout(args.scenario, args.steps, args.seed, args.strip_frames, split=args.split, **difficulty)
+    print(f"{args.scenario} {difficulty} ({args.split}), random policy, {args.steps} agent steps")
     print(f"  episodes finished : {result['episodes']}")
-    print(f"  success rate      : {100 * result['success_rate']:.1f}%")
+    for key, value in result["metrics"].items():
+        print(f"  {key:<18}: {value:.3g} (mean)")
     print(f"  mean return       : {result['mean_return']:.3f}")
     print(f"  speed             : {result['obs_per_s']:.0f} obs/s (one process, GL backend {render.gl_backend()})")
 

@@ -177,3 +177,17 @@ def test_bad_input_through_gymnasium():
         gymnasium.make("mjmaze/Labyrinth-v0", size=15)
     with pytest.raises(ValueError, match="size"):
         gymnasium.make("mjmaze/Labyrinth-v0", colour="red")
+
+
+def test_random_rollout_prints_metrics_and_writes_a_frame_strip(tmp_path, capsys):
+    import imageio.v3 as iio
+
+    from mjmaze import rollout
+
+    out = tmp_path / "frames.png"
+    rollout.main(["--scenario", "two_colour", "--complexity", "1", "--steps", "120", "--strip-frames", "4",
+                  "--out", str(out)])
+    printed = capsys.readouterr().out
+    assert "obs/s" in printed and "two_colour" in printed
+    strip = iio.imread(out)
+    assert strip.shape == (64, 4 * 112, 3) and strip.std() > 0
