@@ -129,3 +129,27 @@ def test_evaluation_plays_every_configuration_twice(tmp_path, monkeypatch):
         assert 0.0 <= result[split]["value"] <= 100.0
     saved = json.loads((run / "eval.json").read_text())
     assert saved["test"]["episodes"] == 16 and saved["units"] == "success %"
+
+
+def test_sigterm_saves_a_final_checkpoint(tmp_path):
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    command = [sys.executable, "-m", "train.a2c", "--size", "5", "--num-envs", "2", "--num-steps", "8",
+               "--total-steps", "100000000", "--runs-dir", str(tmp_path), "--run-name", "term", "--no-progress",
+               "--checkpoint-every", "1000000000"]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    metrics = tmp_path / "term" / "metrics.jsonl"
+    deadline = time.monotonic() + 120
+    while not (metrics.exists() and metrics.read_text().count("\n") >= 2):
+        assert process.poll() is None and time.monotonic() < deadline, process.stdout.read()
+        time.sleep(0.2)
+    os.kill(process.pid, signal.SIGTERM)
+    output, _ = process.communicate(timeout=60)
+    assert process.returncode == 130, output
+    saved = checkpoint.checkpoints(tmp_path / "term" / "checkpoints")
+    assert len(saved) == 1 and checkpoint.load(saved[0])["step"] >= 32
+    assert "stopped at step" in output

@@ -152,7 +152,7 @@ def pick_device(name: str) -> torch.device:
 
 
 class _Stop(Exception):
-    """SIGTERM, turned into a clean stop."""
+    """Ctrl-C or SIGTERM, turned into a clean stop."""
 
 
 def train(args: Args) -> pathlib.Path:
@@ -212,7 +212,9 @@ def _loop(args, envs, agent, optimizer, device, run_dir, step, update) -> pathli
     metrics_file = open(run_dir / "metrics.jsonl", "a")
     next_checkpoint = (step // args.checkpoint_every + 1) * args.checkpoint_every
     bar = tqdm(total=args.total_steps, initial=step, unit="step", disable=not args.progress, dynamic_ncols=True)
-    previous_handler = signal.signal(signal.SIGTERM, _raise_stop)
+    # Ctrl-C and SIGTERM both end in a final checkpoint (installed explicitly:
+    # a job started in the background may inherit an ignored SIGINT).
+    previous_handlers = {sig: signal.signal(sig, _raise_stop) for sig in (signal.SIGINT, signal.SIGTERM)}
     stopped = False
     try:
         while step < args.total_steps:
@@ -273,7 +275,8 @@ def _loop(args, envs, agent, optimizer, device, run_dir, step, update) -> pathli
     except (KeyboardInterrupt, _Stop):
         stopped = True
     finally:
-        signal.signal(signal.SIGTERM, previous_handler)
+        for sig, handler in previous_handlers.items():
+            signal.signal(sig, handler)
         bar.close()
         writer.close()
         metrics_file.close()
