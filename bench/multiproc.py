@@ -36,8 +36,8 @@ def _peak_rss_mb(pid: int) -> float:
     return float("nan")
 
 
-def bench_vector(num_envs: int, size: int, seconds: float) -> tuple[float, float]:
-    """obs/s of the vector env and the peak RSS of its largest worker (MB)."""
+def bench_vector(num_envs: int, size: int, seconds: float, timings: dict | None = None) -> tuple[float, float]:
+    """obs/s of the vector env and the peak RSS of its largest worker (MB); fills ``timings`` if given."""
     envs = MazeVectorEnv(num_envs, "labyrinth", size=size, copy=False)
     rng = np.random.default_rng(0)
     envs.reset(seed=0)
@@ -49,6 +49,8 @@ def bench_vector(num_envs: int, size: int, seconds: float) -> tuple[float, float
         steps += 1
     rate = steps * num_envs / (time.perf_counter() - start)
     rss = max(_peak_rss_mb(p.pid) for p in envs._processes)
+    if timings is not None:
+        timings.update(envs.timings())
     envs.close()
     return rate, rss
 
@@ -126,8 +128,10 @@ def main() -> None:
     rates: dict[str, list[float]] = {"mjmaze (16 envs)": [], f"raw ({CORES} procs)": []}
     if have_vizdoom:
         rates[f"vizdoom ({CORES} procs)"] = []
+    phases: list[dict] = []
     for _ in range(args.rounds):
-        rates["mjmaze (16 envs)"].append(bench_vector(16, 9, args.seconds)[0])
+        phases.append({})
+        rates["mjmaze (16 envs)"].append(bench_vector(16, 9, args.seconds, phases[-1])[0])
         rates[f"raw ({CORES} procs)"].append(bench_processes(_raw_process, args.seconds))
         if have_vizdoom:
             rates[f"vizdoom ({CORES} procs)"].append(bench_processes(_vizdoom_process, args.seconds))
@@ -141,6 +145,10 @@ def main() -> None:
         print(f"  ratio mjmaze / ViZDoom : {mjmaze_rate / median[f'vizdoom ({CORES} procs)']:.2f}")
     else:
         print("  ViZDoom skipped: `pip install -e .[bench]` (the vizdoom package) to compare.")
+    step = {key: statistics.median(p[key] for p in phases) for key in phases[0]}
+    print(f"  mjmaze step by phase (us per step of 16 envs): step {step['step']:.0f} = parent's own work "
+          f"{step['parent']:.0f} + sending/waiting {step['waiting']:.0f}; a worker is busy {step['worker_busy']:.0f} "
+          f"of it ({step['worker_busy'] / 8:.0f} per env), idle {step['waiting'] - step['worker_busy']:.0f}")
 
     if args.no_scaling:
         return

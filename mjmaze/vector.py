@@ -54,12 +54,13 @@ class WorkerError(RuntimeError):
     """A worker process of :class:`MazeVectorEnv` failed; the vector env is closed."""
 
 
-def _array_layout(num_envs: int, frame_shape: tuple[int, ...], scalar_dtype: np.dtype, same_step: bool):
+def _array_layout(num_envs: int, num_workers: int, frame_shape: tuple[int, ...], scalar_dtype: np.dtype, same_step: bool):
     """``[(name, shape, dtype)]`` of the arrays that live in shared memory."""
     layout = [
         ("obs", (num_envs, *frame_shape), np.dtype(np.uint8)),
         ("actions", (num_envs,), np.dtype(np.int64)),
         ("scalars", (num_envs,), scalar_dtype),
+        ("busy_seconds", (num_workers,), np.dtype(np.float64)),  # per worker, for timings()
     ]
     if same_step:
         layout += [("final_obs", (num_envs, *frame_shape), np.dtype(np.uint8)), ("final_scalars", (num_envs,), scalar_dtype)]
@@ -107,8 +108,11 @@ def _worker(worker_id, conn, shm_name, layout, env_ids, first_configs, scenario,
             env.task.observation_buffer = arrays["obs"][slot]
             envs.append((slot, env))
         conn.send(None)
+        busy = arrays["busy_seconds"]
+        clock = time.perf_counter
         while True:
             command, argument = conn.recv()
+            started = clock()
             if command == "step":
                 actions = arrays["actions"]
                 for slot, env in envs:
@@ -133,6 +137,7 @@ def _worker(worker_id, conn, shm_name, layout, env_ids, first_configs, scenario,
                     _write_info(columns, slot, env.task.get_info(env.physics))
             elif command == "close":
                 break
+            busy[worker_id] += clock() - started
             conn.send(None)
     except BaseException as error:  # noqa: BLE001 - report anything to the parent, then exit
         try:
@@ -143,7 +148,7 @@ def _worker(worker_id, conn, shm_name, layout, env_ids, first_configs, scenario,
         for _, env in envs:
             env.task.observation_buffer = None
             env.task.close()
-        del arrays, scalars, columns, final_columns, envs
+        del arrays, scalars, columns, final_columns, envs, busy
         segment.close()
         conn.close()
 
@@ -214,6 +219,8 @@ class MazeVectorEnv(gym.vector.VectorEnv):
         self.closed = False
         self._copy = copy
         self._timeout = float(timeout)
+        self._steps_taken = 0
+        self._step_seconds = self._wait_seconds = 0.0
         self._error: WorkerError | None = None
 
         scalar_dtype = np.dtype(
@@ -221,7 +228,7 @@ class MazeVectorEnv(gym.vector.VectorEnv):
             + [(name, np.dtype(kind)) for name, kind in info_fields.items()]
         )
         self._info_fields = tuple(info_fields)
-        layout = _array_layout(self.num_envs, frame_spec.shape, scalar_dtype, mode == AutoresetMode.SAME_STEP)
+        layout = _array_layout(self.num_envs, num_workers, frame_spec.shape, scalar_dtype, mode == AutoresetMode.SAME_STEP)
         self._shm = shared_memory.SharedMemory(
             name=SHARED_MEMORY_PREFIX + secrets.token_hex(8), create=True, size=_layout_size(layout)
         )
@@ -271,8 +278,12 @@ class MazeVectorEnv(gym.vector.VectorEnv):
 
     def step(self, actions):
         self._check_usable()
+        started = time.perf_counter()
         self._arrays["actions"][:] = actions
+        sent = time.perf_counter()
         self._send_all("step", None)
+        self._wait_seconds += time.perf_counter() - sent
+        self._steps_taken += 1
         scalars = self._scalars
         infos = self._infos()
         if self.autoreset_mode == AutoresetMode.SAME_STEP:
@@ -281,13 +292,32 @@ class MazeVectorEnv(gym.vector.VectorEnv):
             for i in ended:
                 final_info = {name: final_scalars[name][i].item() for name in self._info_fields}
                 infos = self._add_info(infos, {"final_obs": self._arrays["final_obs"][i].copy(), "final_info": final_info}, int(i))
-        return (
+        result = (
             self._observations(),
             scalars["reward"].copy(),
             scalars["terminated"].copy(),
             scalars["truncated"].copy(),
             infos,
         )
+        self._step_seconds += time.perf_counter() - started
+        return result
+
+    def timings(self) -> dict[str, float]:
+        """Where a step's time went, in microseconds per step, averaged since the start.
+
+        ``step``: one call of :meth:`step`; ``parent``: the calling process's own
+        work in it; ``waiting``: the calling process sending the step and waiting for workers;
+        ``worker_busy``: a worker stepping its envs (mean over workers); the rest
+        of ``waiting`` is workers idling (for each other, or waking up).
+        """
+        steps = max(self._steps_taken, 1)
+        busy = float(np.mean(self._arrays["busy_seconds"])) if self._arrays is not None else float("nan")
+        return {
+            "step": 1e6 * self._step_seconds / steps,
+            "parent": 1e6 * (self._step_seconds - self._wait_seconds) / steps,
+            "waiting": 1e6 * self._wait_seconds / steps,
+            "worker_busy": 1e6 * busy / steps,
+        }
 
     def render(self) -> tuple[np.ndarray, ...] | None:
         if self.render_mode != "rgb_array":
