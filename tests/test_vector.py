@@ -37,6 +37,8 @@ def test_make_vec_returns_the_shared_memory_vector_env():
     assert {"success", "yaw", "config_index", "episode_return"} <= set(infos)
     assert len({frame.tobytes() for frame in obs}) == 4  # four different envs
     assert envs.metadata["autoreset_mode"] == gymnasium.vector.AutoresetMode.NEXT_STEP
+    timings = envs.timings()  # where the step went
+    assert 0 < timings["worker_busy"] <= timings["waiting"] <= timings["step"]
     envs.close()
 
 
