@@ -137,7 +137,8 @@ def _worker(worker_id, conn, shm_name, layout, env_ids, first_configs, scenario,
                     _write_info(columns, slot, env.task.get_info(env.physics))
             elif command == "close":
                 break
-            busy[worker_id] += clock() - started
+            if command == "step":
+                busy[worker_id] += clock() - started
             conn.send(None)
     except BaseException as error:  # noqa: BLE001 - report anything to the parent, then exit
         try:
@@ -307,7 +308,8 @@ class MazeVectorEnv(gym.vector.VectorEnv):
 
         ``step``: one call of :meth:`step`; ``parent``: the calling process's own
         work in it; ``waiting``: the calling process sending the step and waiting for workers;
-        ``worker_busy``: a worker stepping its envs (mean over workers); the rest
+        ``worker_busy``: a worker stepping its envs (mean over workers, resets by
+        :meth:`reset` not counted); the rest
         of ``waiting`` is workers idling (for each other, or waking up).
         """
         steps = max(self._steps_taken, 1)
