@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import mjmaze
-from mjmaze.tasks import base, find_return, k_item, two_colour
+from mjmaze.tasks import base, k_item, two_colour
 
 from conftest import FORWARD, TURN_LEFT, place
 
@@ -57,7 +57,7 @@ def test_pillars_block_movement_and_stay_touchable():
     red = env.task.config.cell_centre(env.task.config.object_cells[0])
     place(env, red[0] - 0.45, red[1], 0.0)
     for _ in range(4):
-        timestep = env.step(FORWARD)
+        env.step(FORWARD)
     x = env.physics.agent_pose()[0]
     # Stopped at its radius + the pillar's (0.25 m), inside the 0.3 m touch range.
     assert red[0] - x == pytest.approx(0.25, abs=0.03)

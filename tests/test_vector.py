@@ -7,7 +7,6 @@ import gymnasium
 import numpy as np
 import pytest
 
-import mjmaze
 from mjmaze.vector import SHARED_MEMORY_PREFIX, MazeVectorEnv, WorkerError
 
 TURN_LEFT = 0

@@ -30,6 +30,7 @@ import torch
 import tyro
 from torch.nn import functional as F
 
+from mjmaze import suite
 from mjmaze.vector import MazeVectorEnv
 from train import checkpoint
 from train.model import Agent
@@ -101,12 +102,10 @@ class Args:
     def task_kwargs(self) -> dict:
         """The scenario's task arguments from these flags."""
         kwargs = {"size": self.size, "num_items": self.num_items, "complexity": self.complexity}
-        allowed = {"labyrinth": {"size"}, "find_return": {"size"}, "k_item": {"num_items", "size"}, "two_colour": {"complexity"}}
-        if self.scenario not in allowed:
-            raise ValueError(f"unknown scenario {self.scenario!r}; valid: {tuple(allowed)}")
-        extra = {k for k, v in kwargs.items() if v is not None} - allowed[self.scenario]
+        allowed = set(kwargs) & set(suite.task_kwarg_names(self.scenario))  # raises on an unknown scenario
+        extra = {k for k, v in kwargs.items() if v is not None} - allowed
         if extra:
-            raise ValueError(f"{self.scenario} takes no {sorted(extra)}; it takes {sorted(allowed[self.scenario])}")
+            raise ValueError(f"{self.scenario} takes no {sorted(extra)}; it takes {sorted(allowed)}")
         kwargs = {k: v for k, v in kwargs.items() if v is not None}
         if self.num_configs is not None:
             kwargs["num_configs"] = self.num_configs
