@@ -22,6 +22,8 @@ import numpy as np
 WALL_THICKNESS = 0.125
 WALL_HEIGHT = 1.0
 WALL_MESH = "walls"
+OVERHEAD_CAMERA = "overhead"
+OVERHEAD_HEIGHT = 10.0
 
 # Per wall box in the visual mesh: 8 corners, 4 side faces + the top (10
 # triangles; the bottom is never seen), one normal per visible face.
@@ -74,6 +76,11 @@ def wall_segments(grid_size: int, cell_size: float) -> np.ndarray:
     return np.array(rows, dtype=np.float64)
 
 
+def overhead_extent(grid_size: int, cell_size: float) -> float:
+    """Side in metres of the square the overhead camera sees: the arena and a small border."""
+    return grid_size * cell_size + 2 * WALL_THICKNESS + 0.25
+
+
 def build_xml(grid_size: int, cell_size: float, objects: Sequence[ObjectGeom] = ()) -> str:
     """The MJCF of an arena for ``grid_size x grid_size`` cells of ``cell_size`` metres."""
     root = ET.fromstring(template_path().read_text())
@@ -99,6 +106,12 @@ def build_xml(grid_size: int, cell_size: float, objects: Sequence[ObjectGeom] = 
     ET.SubElement(
         worldbody, "geom", name="floor", type="plane", material="floor",
         size=f"{half_extent} {half_extent} {cell_size}",
+    )
+    # An orthographic camera looking straight down at the whole arena, image up
+    # = +y, for top-down maps (mjmaze.viz); fovy is then the view's height in metres.
+    ET.SubElement(
+        worldbody, "camera", name=OVERHEAD_CAMERA, pos=f"0 0 {OVERHEAD_HEIGHT}", projection="orthographic",
+        fovy=f"{overhead_extent(grid_size, cell_size)}",
     )
     for k, (x, y, hx, hy) in enumerate(segments):
         ET.SubElement(

@@ -13,16 +13,13 @@ units of the paper's Table 2, and prints the table.
 from __future__ import annotations
 
 import argparse
-import dataclasses
-import json
 import pathlib
 
 import numpy as np
 import torch
 
-from mjmaze import suite
 from mjmaze.vector import MazeVectorEnv
-from train import checkpoint
+from train import checkpoint, policy
 from train.a2c import PAPER_METRIC, Args, pick_device
 from train.model import Agent
 
@@ -76,25 +73,11 @@ def play_split(agent: Agent, args: Args, split: str, num_envs: int, device: torc
 def evaluate(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | None = None, num_envs: int = 16,
              device: str = "auto") -> dict:
     """Evaluates a run's checkpoint (default: its latest) on train and test; writes ``eval.json``."""
-    run_dir = pathlib.Path(run_dir)
-    config_file = run_dir / "config.json"
-    if not config_file.exists():
-        raise FileNotFoundError(f"{run_dir} is not a training run (no config.json)")
-    args = Args(**json.loads(config_file.read_text()))
-    if checkpoint_path is None:
-        found = checkpoint.checkpoints(run_dir / "checkpoints")
-        if not found:
-            raise FileNotFoundError(f"no checkpoint in {run_dir / 'checkpoints'}")
-        checkpoint_path = found[-1]
-    state = checkpoint.load(pathlib.Path(checkpoint_path), dataclasses.asdict(args))
     torch_device = pick_device(device)
-    task = suite.make_task(args.scenario, {k: v for k, v in args.task_kwargs().items() if k != "num_configs"})
-    agent = Agent(task.action_spec(None).num_values, task.observation_spec(None)["pixels"].shape).to(torch_device)
-    agent.load_state_dict(state["model"])
-    agent.eval()
+    args, agent, state = policy.load_run(run_dir, checkpoint_path, torch_device)
     result = {
         "run": str(run_dir),
-        "checkpoint": str(checkpoint_path),
+        "checkpoint": state["path"],
         "step": int(state["step"]),
         "scenario": args.scenario,
         "task_kwargs": args.task_kwargs(),
@@ -102,7 +85,7 @@ def evaluate(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | 
     }
     for split in ("train", "test"):
         result[split] = play_split(agent, args, split, num_envs, torch_device)
-    checkpoint.atomic_write_json(run_dir / "eval.json", result)
+    checkpoint.atomic_write_json(pathlib.Path(run_dir) / "eval.json", result)
     return result
 
 

@@ -1,0 +1,185 @@
+"""Hidden-state analysis, as in the paper's Fig. 1 and Fig. 7.
+
+    python -m train.analysis runs/two_colour_5_s0 --episodes 20
+    python -m train.analysis random --scenario two_colour --complexity 5 --episodes 4 --max-steps 100
+
+Plays ``--episodes`` episodes (greedy; ``--sample`` to sample) on the test
+configurations, records the GRU state after every frame, and writes into
+``--out`` (default ``<run>/analysis``):
+
+- ``states.npz``: every recorded state with its episode, step, pose, and, per
+  episode, the step at which the landmark (Two-colour's totem, Labyrinth's exit,
+  Find-and-return's red pillar, K-item's first item) first came into view;
+- ``heatmap.png``: the 128 activations of episode 0 over time, that step marked;
+- ``tsne.png`` and ``tsne.npz``: a t-SNE (scikit-learn) of up to
+  ``--tsne-states`` states drawn evenly from all episodes, coloured by time step,
+  with up to 20 episodes drawn as lines; for Two-colour a second panel coloured
+  by the totem's colour;
+- ``summary.json``: what was played and written.
+
+``random`` analyses an untrained agent acting uniformly at random: the baseline
+against which a trained agent's structure stands out.
+"""
+
+from __future__ import annotations
+
+import argparse
+import io
+import pathlib
+
+import numpy as np
+from matplotlib.figure import Figure
+
+import mjmaze
+from train import checkpoint, policy
+from train.a2c import PAPER_METRIC
+
+TSNE_STATES = 2000
+TSNE_LINES = 20
+
+
+def record_states(source_args: argparse.Namespace, episodes: int, max_steps: int | None = None):
+    """Plays the episodes; returns ``(scenario, task kwargs, description, episodes)``."""
+    scenario, task_kwargs, agent_policy, description = policy.policy_from_arguments(source_args)
+    env = mjmaze.load(scenario, task_kwargs={**task_kwargs, "split": source_args.split, "random": source_args.seed})
+    try:
+        played = policy.play_episodes(env, agent_policy, episodes, max_steps=max_steps)
+    finally:
+        env.task.close()
+    return scenario, task_kwargs, description, played
+
+
+def save_figure(figure: Figure, path: pathlib.Path) -> pathlib.Path:
+    """Saves a matplotlib figure as a PNG, atomically."""
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=110, bbox_inches="tight")
+    checkpoint.atomic_write_bytes(path, buffer.getvalue())
+    return path
+
+
+def heatmap(episode: policy.Episode, scenario: str, title: str) -> Figure:
+    """Activations of one episode over time, the landmark's first sighting marked."""
+    figure = Figure(figsize=(10, 4))
+    axes = figure.subplots()
+    image = axes.imshow(episode.hidden.T, aspect="auto", cmap="RdBu_r", vmin=-1, vmax=1, interpolation="nearest")
+    seen = episode.landmark_first_seen
+    if seen is not None and seen < episode.length:
+        axes.axvline(seen, color="k", linestyle="--", linewidth=1.5,
+                     label=f"{policy.LANDMARK[scenario]} first in view (step {seen})")
+        axes.legend(loc="upper right", fontsize=8, framealpha=0.9)
+    axes.set_xlabel("step")
+    axes.set_ylabel("hidden unit")
+    axes.set_title(title, fontsize=10)
+    figure.colorbar(image, ax=axes, label="activation")
+    return figure
+
+
+def tsne_sample(lengths: list[int], count: int, seed: int) -> np.ndarray:
+    """Indices of up to ``count`` states drawn evenly from all episodes, in time order."""
+    total = sum(lengths)
+    if total <= count:
+        return np.arange(total)
+    return np.sort(np.random.default_rng(seed).choice(total, size=count, replace=False))
+
+
+def tsne(states: np.ndarray, seed: int) -> np.ndarray:
+    """2-D t-SNE embedding of ``states`` (scikit-learn, PCA initialisation)."""
+    from sklearn.manifold import TSNE
+
+    perplexity = float(min(30.0, max(2.0, (len(states) - 1) / 3)))
+    return TSNE(n_components=2, perplexity=perplexity, init="pca", random_state=seed).fit_transform(states)
+
+
+def tsne_figure(embedding: np.ndarray, steps: np.ndarray, episode_of: np.ndarray, title: str,
+                totem_green: np.ndarray | None = None) -> Figure:
+    panels = 1 if totem_green is None else 2
+    figure = Figure(figsize=(6.5 * panels, 5.5))
+    axes = np.atleast_1d(figure.subplots(1, panels))
+    points = axes[0].scatter(embedding[:, 0], embedding[:, 1], c=steps, cmap="viridis", s=6)
+    figure.colorbar(points, ax=axes[0], label="time step")
+    for e in np.unique(episode_of)[:TSNE_LINES]:
+        along = embedding[episode_of == e]
+        axes[0].plot(along[:, 0], along[:, 1], color="k", alpha=0.25, linewidth=0.6)
+    axes[0].set_title(f"{title}\ncoloured by time step, {min(TSNE_LINES, len(np.unique(episode_of)))} episodes as lines",
+                      fontsize=9)
+    if totem_green is not None:
+        colours = np.where(totem_green, "tab:green", "tab:red")
+        axes[1].scatter(embedding[:, 0], embedding[:, 1], c=colours, s=6)
+        axes[1].set_title("coloured by the totem's colour", fontsize=9)
+    for ax in axes:
+        ax.set_xticks([])
+        ax.set_yticks([])
+    return figure
+
+
+def analyse(source_args: argparse.Namespace, episodes: int, out: pathlib.Path | None = None,
+            tsne_states: int = TSNE_STATES, max_steps: int | None = None) -> dict:
+    """Records states, writes the files listed in the module docstring; returns the summary."""
+    scenario, task_kwargs, description, played = record_states(source_args, episodes, max_steps)
+    if out is None:
+        out = pathlib.Path(source_args.source) / "analysis" if source_args.source != policy.RANDOM \
+            else pathlib.Path("runs") / f"analysis_random_{scenario}"
+    played = [e for e in played if e.length > 0]
+    if not played:
+        raise ValueError("no episode lasted a step: nothing to analyse")
+    title = f"{description} | {scenario} {task_kwargs} | {source_args.split}"
+    hidden = np.concatenate([e.hidden for e in played])
+    episode_of = np.concatenate([np.full(e.length, k) for k, e in enumerate(played)])
+    steps = np.concatenate([np.arange(e.length) for e in played])
+    poses = np.concatenate([e.poses[:-1] for e in played])
+    first_seen = np.array([-1 if e.landmark_first_seen is None else e.landmark_first_seen for e in played])
+    totem_green = None
+    if scenario == "two_colour":
+        totem_green = np.concatenate([np.full(e.length, bool(e.infos[0]["totem_green"])) for e in played])
+
+    buffer = io.BytesIO()
+    np.savez_compressed(buffer, hidden=hidden, episode=episode_of, step=steps, pose=poses,
+                        landmark_first_seen=first_seen, **({"totem_green": totem_green} if totem_green is not None else {}))
+    checkpoint.atomic_write_bytes(out / "states.npz", buffer.getvalue())
+    save_figure(heatmap(played[0], scenario, f"episode 0 ({played[0].length} steps) - {title}"), out / "heatmap.png")
+
+    chosen = tsne_sample([e.length for e in played], tsne_states, source_args.seed)
+    embedding = tsne(hidden[chosen], source_args.seed)
+    buffer = io.BytesIO()
+    np.savez_compressed(buffer, embedding=embedding, state_index=chosen)
+    checkpoint.atomic_write_bytes(out / "tsne.npz", buffer.getvalue())
+    save_figure(tsne_figure(embedding, steps[chosen], episode_of[chosen], title,
+                            None if totem_green is None else totem_green[chosen]), out / "tsne.png")
+
+    field, scale, units = PAPER_METRIC[scenario]
+    summary = {
+        "source": source_args.source, "description": description, "scenario": scenario, "task_kwargs": task_kwargs,
+        "split": source_args.split, "states": len(hidden), "tsne_points": len(embedding),
+        "landmark": policy.LANDMARK[scenario],
+        "episodes": [
+            {"config_index": e.config_index, "length": e.length, "return": float(e.rewards.sum()),
+             units: float(e.infos[-1][field]) * scale, "landmark_first_seen": e.landmark_first_seen,
+             **({"totem_green": bool(e.infos[0]["totem_green"])} if scenario == "two_colour" else {})}
+            for e in played
+        ],
+        "files": [str(out / name) for name in ("states.npz", "heatmap.png", "tsne.png", "tsne.npz", "summary.json")],
+    }
+    checkpoint.atomic_write_json(out / "summary.json", summary)
+    return summary
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    policy.policy_arguments(parser)
+    parser.add_argument("--episodes", type=int, default=20)
+    parser.add_argument("--tsne-states", type=int, default=TSNE_STATES, help="states in the t-SNE")
+    parser.add_argument("--max-steps", type=int, default=None, help="cut episodes after this many steps")
+    parser.add_argument("--out", type=pathlib.Path, default=None, help="default: <run>/analysis")
+    args = parser.parse_args(argv)
+    try:
+        summary = analyse(args, args.episodes, args.out, args.tsne_states, args.max_steps)
+    except (checkpoint.CheckpointError, FileNotFoundError, ValueError) as error:
+        raise SystemExit(f"error: {error}") from None
+    seen = [e["landmark_first_seen"] for e in summary["episodes"] if e["landmark_first_seen"] is not None]
+    print(f"{summary['states']} states from {len(summary['episodes'])} episodes; t-SNE of {summary['tsne_points']}; "
+          f"{summary['landmark']} seen in {len(seen)} episodes")
+    print("written: " + ", ".join(summary["files"]))
+
+
+if __name__ == "__main__":
+    main()
