@@ -17,6 +17,15 @@ _TASKS = {
 }
 ALL_TASKS = tuple(_TASKS)
 
+# Each scenario's headline metric in the units of the paper's Table 2:
+# (field of info, scale, units).
+PAPER_METRIC = {
+    "labyrinth": ("success", 100.0, "success %"),
+    "find_return": ("success", 100.0, "success %"),
+    "k_item": ("item_score", 1.0, "items in order / K"),
+    "two_colour": ("duration", 1.0, "tics survived"),
+}
+
 
 def _parameters(function, skip=("self", "kwargs", "difficulty", "layout")) -> tuple[str, ...]:
     return tuple(p for p in inspect.signature(function).parameters if p not in skip)

@@ -35,13 +35,7 @@ from mjmaze.vector import MazeVectorEnv
 from train import checkpoint
 from train.model import Agent
 
-# The scenario's headline metric in the units of the paper's Table 2: (info field, scale, label).
-PAPER_METRIC = {
-    "labyrinth": ("success", 100.0, "success %"),
-    "find_return": ("success", 100.0, "success %"),
-    "k_item": ("item_score", 1.0, "items in order / K"),
-    "two_colour": ("duration", 1.0, "tics survived"),
-}
+PAPER_METRIC = suite.PAPER_METRIC  # (info field, scale, units) per scenario
 
 
 @dataclasses.dataclass

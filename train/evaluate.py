@@ -71,8 +71,11 @@ def play_split(agent: Agent, args: Args, split: str, num_envs: int, device: torc
 
 
 def evaluate(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | None = None, num_envs: int = 16,
-             device: str = "auto") -> dict:
-    """Evaluates a run's checkpoint (default: its latest) on train and test; writes ``eval.json``."""
+             device: str = "auto", out: str | pathlib.Path | None = None) -> dict:
+    """Evaluates a run's checkpoint (default: its latest) on train and test.
+
+    Writes the result to ``out`` (default: the run's ``eval.json``).
+    """
     torch_device = pick_device(device)
     args, agent, state = policy.load_run(run_dir, checkpoint_path, torch_device)
     result = {
@@ -85,7 +88,7 @@ def evaluate(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | 
     }
     for split in ("train", "test"):
         result[split] = play_split(agent, args, split, num_envs, torch_device)
-    checkpoint.atomic_write_json(pathlib.Path(run_dir) / "eval.json", result)
+    checkpoint.atomic_write_json(pathlib.Path(out) if out else pathlib.Path(run_dir) / "eval.json", result)
     return result
 
 

@@ -1,0 +1,109 @@
+"""Videos, hidden-state analysis and learning curves, on a random policy and on tiny trained runs."""
+
+import json
+
+import imageio.v2 as imageio
+import imageio.v3 as iio
+import numpy as np
+import pytest
+
+from train import a2c, analysis, curves, evaluate, record
+
+
+def tiny_run(tmp_path, name, **overrides):
+    settings = dict(
+        scenario="labyrinth", size=5, total_steps=32, num_envs=2, num_steps=8, runs_dir=str(tmp_path),
+        run_name=name, checkpoint_every=16, progress=False, torch_threads=1,
+    )
+    settings.update(overrides)
+    return a2c.train(a2c.Args(**settings))
+
+
+def picture(path):
+    image = iio.imread(path)
+    assert image.ndim == 3 and image.std() > 5, f"{path} is blank"
+    return image
+
+
+def test_video_of_a_random_policy_holds_one_frame_per_step(tmp_path, capsys):
+    out = tmp_path / "episode.mp4"
+    record.main(["random", "--scenario", "k_item", "--num-items", "2", "--size", "5", "--episodes", "2",
+                 "--max-steps", "12", "--out", str(out)])
+    summary = json.loads(out.with_suffix(".json").read_text())
+    expected = sum(e["length"] + 1 for e in summary["episodes"])  # the start frame and one per step
+    assert summary["frames"] == expected == imageio.get_reader(out).count_frames()
+    assert len(summary["episodes"]) == 2 and all(len(e["path"]) == e["length"] + 1 for e in summary["episodes"])
+    assert "written" in capsys.readouterr().out
+    frame = imageio.get_reader(out).get_data(5)
+    assert frame.shape[1] == 448 + 256 and frame.std() > 10
+    assert not list(tmp_path.glob(".*tmp*"))  # no temporary file left behind
+
+
+def test_video_falls_back_to_gif(tmp_path):
+    out = tmp_path / "episode.gif"
+    record.main(["random", "--scenario", "two_colour", "--episodes", "1", "--max-steps", "6", "--out", str(out)])
+    frames = iio.imread(out, index=None)
+    assert frames.shape[0] == 7 and frames.std() > 10
+
+
+def test_video_of_a_trained_run_and_flags_that_contradict_it(tmp_path):
+    run = tiny_run(tmp_path, "tiny")
+    out = tmp_path / "run.mp4"
+    record.main([str(run), "--episodes", "1", "--max-steps", "5", "--out", str(out)])
+    summary = json.loads(out.with_suffix(".json").read_text())
+    assert summary["scenario"] == "labyrinth" and summary["task_kwargs"] == {"size": 5} and summary["frames"] == 6
+    with pytest.raises(SystemExit, match="was trained on labyrinth"):
+        record.main([str(run), "--size", "7", "--out", str(out)])
+    with pytest.raises(SystemExit, match="no config.json"):
+        record.main([str(tmp_path / "nothing"), "--out", str(out)])
+
+
+def test_hidden_state_analysis_of_a_random_policy_on_two_colour(tmp_path):
+    out = tmp_path / "analysis"
+    analysis.main(["random", "--scenario", "two_colour", "--complexity", "3", "--episodes", "3", "--max-steps", "40",
+                   "--out", str(out)])
+    summary = json.loads((out / "summary.json").read_text())
+    states = np.load(out / "states.npz")
+    recorded = sum(e["length"] for e in summary["episodes"])
+    assert states["hidden"].shape == (recorded, 128) == (summary["states"], 128)
+    assert np.abs(states["hidden"]).max() > 0
+    assert len(np.load(out / "tsne.npz")["embedding"]) == recorded == summary["tsne_points"]
+    assert {e["totem_green"] for e in summary["episodes"]} <= {True, False}
+    assert states["totem_green"].shape == (recorded,)
+    assert summary["landmark"] == "totem"
+    seen = [e["landmark_first_seen"] for e in summary["episodes"]]
+    assert list(states["landmark_first_seen"]) == [-1 if s is None else s for s in seen]
+    picture(out / "heatmap.png")
+    two_panels = picture(out / "tsne.png")
+    assert two_panels.shape[1] > 1.5 * two_panels.shape[0]  # the totem-colour panel beside the time panel
+
+
+def test_tsne_keeps_at_most_the_asked_number_of_states(tmp_path):
+    out = tmp_path / "analysis"
+    run = tiny_run(tmp_path, "tiny")
+    analysis.main([str(run), "--episodes", "2", "--max-steps", "50", "--tsne-states", "60", "--out", str(out)])
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["states"] == 100 and summary["tsne_points"] == 60
+    assert len(np.load(out / "tsne.npz")["embedding"]) == 60
+    assert summary["landmark"] == "exit"
+    picture(out / "tsne.png")
+
+
+def test_learning_curves_average_seeds_with_train_and_test_evaluations(tmp_path, monkeypatch):
+    # Random agents die within ~100 steps in Two-colour: training episodes end in a tiny run.
+    runs = [tiny_run(tmp_path, f"tc_s{seed}", scenario="two_colour", size=None, complexity=3, seed=seed,
+                     total_steps=320, checkpoint_every=160) for seed in (0, 1)]
+    other = tiny_run(tmp_path, "lab", keep_checkpoints=1)
+    monkeypatch.setattr(evaluate, "EVAL_CONFIGS", 4)
+    out = tmp_path / "curves.png"
+    curves.main([*map(str, runs), str(other), "--evaluate", "--num-envs", "4", "--out", str(out)])
+    groups = json.loads(out.with_suffix(".json").read_text())
+    assert [g["label"] for g in groups] == ["two_colour complexity=3", "labyrinth size=5"]
+    two_colour = groups[0]
+    assert two_colour["training"]["seeds"] == 2 and two_colour["training"]["step"]
+    assert all(0 < v <= 2100 for v in two_colour["training"]["mean"])
+    assert two_colour["evaluations"]["step"] == [160, 320] and two_colour["evaluations"]["seeds"] == [2, 2]
+    assert all(0 < v <= 2100 for v in two_colour["evaluations"]["test_mean"])
+    for run in runs:
+        assert sorted(p.name for p in (run / "evals").iterdir()) == ["step_000000000160.json", "step_000000000320.json"]
+    picture(out)

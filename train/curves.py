@@ -1,0 +1,199 @@
+"""Learning curves of one or several runs, mean +- std over seeds, in the style of the paper's figures.
+
+    python -m train.curves runs/lab5_s0 runs/lab5_s1 runs/lab7_s0 --out curves.png
+    python -m train.curves runs/lab5_s* --evaluate      # also greedy train/test at every kept checkpoint
+
+Runs with the same scenario and difficulty (config.json) are seeds of one curve
+and share a panel. Solid: the training episodes' metric from ``metrics.jsonl``
+(sampled actions, training mazes), averaged in ``--bins`` step bins. With
+``--evaluate`` (or where a run already has them), greedy evaluations of each
+kept checkpoint on the training and test configurations (``train.evaluate``,
+cached in ``<run>/evals/step_N.json``) are drawn as markers. Writes the PNG and
+``<out>.json`` with every plotted number.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import pathlib
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from train import checkpoint
+from train.a2c import PAPER_METRIC
+from train.analysis import save_figure
+
+BINS = 40
+
+
+def read_run(run_dir: pathlib.Path) -> dict:
+    """A run's config, training metric per update and cached evaluations."""
+    config_file = run_dir / "config.json"
+    if not config_file.exists():
+        raise FileNotFoundError(f"{run_dir} is not a training run (no config.json)")
+    config = json.loads(config_file.read_text())
+    field = PAPER_METRIC[config["scenario"]][0]
+    steps, values = [], []
+    metrics_file = run_dir / "metrics.jsonl"
+    if metrics_file.exists():
+        for line in metrics_file.read_text().splitlines():
+            try:
+                record = json.loads(line)
+            except json.JSONDecodeError:  # a line cut by a crash: skip it
+                continue
+            if field in record:
+                steps.append(record["step"])
+                values.append(record[field])
+    evals = {}
+    for path in sorted((run_dir / "evals").glob("step_*.json")):
+        result = json.loads(path.read_text())
+        evals[int(result["step"])] = (result["train"]["value"], result["test"]["value"])
+    return {"dir": str(run_dir), "config": config, "steps": np.array(steps), "values": np.array(values), "evals": evals}
+
+
+def evaluate_checkpoints(run_dir: pathlib.Path, num_envs: int = 16) -> None:
+    """Greedy evaluation of each kept checkpoint not evaluated yet (cached in ``evals/``)."""
+    from train import evaluate
+
+    for path in checkpoint.checkpoints(run_dir / "checkpoints"):
+        out = run_dir / "evals" / path.with_suffix(".json").name
+        if not out.exists():
+            result = evaluate.evaluate(run_dir, path, num_envs=num_envs, out=out)
+            print(f"  {run_dir.name} step {result['step']:>11,}: train {result['train']['value']:6.1f}  "
+                  f"test {result['test']['value']:6.1f}  ({result['units']})", flush=True)
+
+
+def group_key(config: dict) -> tuple:
+    """What makes runs seeds of one curve: the scenario, its difficulty, the number of training configurations."""
+    return (config["scenario"], config.get("size"), config.get("num_items"), config.get("complexity"),
+            config.get("num_configs"))
+
+
+def label(config: dict) -> str:
+    parts = [config["scenario"]]
+    for key in ("size", "num_items", "complexity", "num_configs"):
+        if config.get(key) is not None:
+            parts.append(f"{key}={config[key]}")
+    return " ".join(parts)
+
+
+def binned(runs: list[dict], bins: int) -> dict:
+    """The training metric of ``runs`` on one grid of step bins: mean and std over runs."""
+    last = max((r["steps"].max() for r in runs if len(r["steps"])), default=0)
+    if last == 0:
+        return {"step": [], "mean": [], "std": [], "seeds": 0}
+    edges = np.linspace(0, last, bins + 1)
+    per_run = []
+    for r in runs:
+        which = np.clip(np.searchsorted(edges, r["steps"], side="left") - 1, 0, bins - 1)
+        sums = np.bincount(which, weights=r["values"], minlength=bins)
+        counts = np.bincount(which, minlength=bins)
+        per_run.append(np.where(counts > 0, sums / np.maximum(counts, 1), np.nan))
+    per_run = np.array(per_run)
+    filled = ~np.all(np.isnan(per_run), axis=0)
+    with np.errstate(invalid="ignore"):
+        mean, std = np.nanmean(per_run[:, filled], axis=0), np.nanstd(per_run[:, filled], axis=0)
+    centres = (edges[:-1] + edges[1:]) / 2
+    return {"step": centres[filled].tolist(), "mean": mean.tolist(), "std": std.tolist(), "seeds": len(runs)}
+
+
+def evaluations(runs: list[dict]) -> dict:
+    """Greedy train/test evaluations at each checkpoint step: mean and std over the runs that have it."""
+    steps = sorted({s for r in runs for s in r["evals"]})
+    out = {"step": steps, "train_mean": [], "train_std": [], "test_mean": [], "test_std": [], "seeds": []}
+    for s in steps:
+        values = np.array([r["evals"][s] for r in runs if s in r["evals"]])
+        out["train_mean"].append(float(values[:, 0].mean()))
+        out["train_std"].append(float(values[:, 0].std()))
+        out["test_mean"].append(float(values[:, 1].mean()))
+        out["test_std"].append(float(values[:, 1].std()))
+        out["seeds"].append(len(values))
+    return out
+
+
+def curves(run_dirs: list[pathlib.Path], bins: int = BINS) -> list[dict]:
+    """One curve per group of seeds, in the order the groups first appear."""
+    groups: dict[tuple, list[dict]] = {}
+    for run_dir in run_dirs:
+        run = read_run(pathlib.Path(run_dir))
+        groups.setdefault(group_key(run["config"]), []).append(run)
+    result = []
+    for runs in groups.values():
+        config = runs[0]["config"]
+        result.append({
+            "label": label(config), "scenario": config["scenario"], "units": PAPER_METRIC[config["scenario"]][2],
+            "runs": [r["dir"] for r in runs], "training": binned(runs, bins), "evaluations": evaluations(runs),
+        })
+    return result
+
+
+def figure(groups: list[dict], title: str = "") -> Figure:
+    """One panel per scenario; each group of seeds a colour: training solid, greedy train o, greedy test x dashed."""
+    scenarios = list(dict.fromkeys(g["scenario"] for g in groups))
+    fig = Figure(figsize=(5.2 * len(scenarios), 4.0))
+    axes = np.atleast_1d(fig.subplots(1, len(scenarios), squeeze=False)[0])
+    colours = iter([f"C{k}" for k in range(100)])
+    for group in groups:
+        ax = axes[scenarios.index(group["scenario"])]
+        colour = next(colours)
+        seeds = len(group["runs"])
+        name = f"{group['label']} ({seeds} seed{'s' * (seeds != 1)})"
+        train = group["training"]
+        if train["step"]:
+            x, mean, std = np.array(train["step"]), np.array(train["mean"]), np.array(train["std"])
+            ax.plot(x, mean, color=colour, label=name)
+            ax.fill_between(x, mean - std, mean + std, color=colour, alpha=0.2, linewidth=0)
+            name = None  # one legend entry per group
+        ev = group["evaluations"]
+        if ev["step"]:
+            ax.errorbar(ev["step"], ev["train_mean"], yerr=ev["train_std"], color=colour, marker="o", linestyle="none",
+                        markersize=4, capsize=2, label=name)
+            ax.errorbar(ev["step"], ev["test_mean"], yerr=ev["test_std"], color=colour, marker="x", linestyle="--",
+                        markersize=5, capsize=2, linewidth=0.8)
+    for ax, scenario in zip(axes, scenarios):
+        ax.set_title(scenario, fontsize=10)
+        ax.set_xlabel("agent steps")
+        ax.set_ylabel(PAPER_METRIC[scenario][2])
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc="best")
+    if title:
+        fig.suptitle(title, fontsize=10)
+    fig.text(0.01, -0.02, "solid: training episodes (sampled); o: greedy on training mazes; x--: greedy on test mazes",
+             fontsize=7)
+    return fig
+
+
+def write(groups: list[dict], out: pathlib.Path, title: str = "") -> pathlib.Path:
+    """Writes the PNG and its ``.json`` numbers."""
+    save_figure(figure(groups, title), out)
+    checkpoint.atomic_write_json(out.with_suffix(".json"), groups)
+    return out
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("runs", nargs="+", type=pathlib.Path, help="run folders")
+    parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("runs/curves.png"))
+    parser.add_argument("--evaluate", action="store_true", help="evaluate kept checkpoints not evaluated yet")
+    parser.add_argument("--num-envs", type=int, default=16, help="parallel envs for --evaluate (must divide 64)")
+    parser.add_argument("--bins", type=int, default=BINS)
+    args = parser.parse_args(argv)
+    try:
+        if args.evaluate:
+            for run_dir in args.runs:
+                evaluate_checkpoints(run_dir, args.num_envs)
+        groups = curves(args.runs, args.bins)
+    except (checkpoint.CheckpointError, FileNotFoundError, ValueError) as error:
+        raise SystemExit(f"error: {error}") from None
+    write(groups, args.out)
+    for g in groups:
+        ev = g["evaluations"]
+        last = f"; last greedy train/test {ev['train_mean'][-1]:.3g}/{ev['test_mean'][-1]:.3g}" if ev["step"] else ""
+        print(f"{g['label']}: {len(g['runs'])} run(s), {len(g['training']['step'])} bins{last} ({g['units']})")
+    print(f"written: {args.out}, {args.out.with_suffix('.json')}")
+
+
+if __name__ == "__main__":
+    main()
