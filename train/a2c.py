@@ -162,6 +162,9 @@ def train(args: Args) -> pathlib.Path:
         if not found:
             raise FileNotFoundError(f"--resume: no checkpoint in {checkpoint_dir}")
         state = checkpoint.load(found[-1], config)
+    # Lines a killed attempt logged after the checkpoint it goes on from (or,
+    # with no checkpoint, before starting over) describe discarded training.
+    _trim_metrics(run_dir / "metrics.jsonl", int(state["step"]) if state else 0)
 
     device = pick_device(args.device)
     if args.torch_threads:
@@ -278,6 +281,20 @@ def _loop(args, envs, agent, optimizer, device, run_dir, step, update) -> pathli
     if stopped:
         raise SystemExit(130)
     return run_dir
+
+
+def _trim_metrics(path: pathlib.Path, step: int) -> None:
+    """Keeps the lines of ``metrics.jsonl`` up to ``step`` (rewritten atomically)."""
+    if not path.exists():
+        return
+    kept = []
+    for line in path.read_text().splitlines():
+        try:
+            if json.loads(line)["step"] <= step:
+                kept.append(line + "\n")
+        except (json.JSONDecodeError, KeyError, TypeError):  # a line cut by a kill
+            continue
+    checkpoint.atomic_write_bytes(path, "".join(kept).encode())
 
 
 def _raise_stop(signum, frame):

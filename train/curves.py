@@ -47,9 +47,11 @@ def read_run(run_dir: pathlib.Path) -> dict:
                 steps.append(record["step"])
                 values.append(record[field])
     evals = {}
-    for path in sorted((run_dir / "evals").glob("step_*.json")):
-        result = json.loads(path.read_text())
-        evals[int(result["step"])] = (result["train"]["value"], result["test"]["value"])
+    # Evaluations of kept checkpoints, and the run's final one (eval.json).
+    for path in [*sorted((run_dir / "evals").glob("step_*.json")), run_dir / "eval.json"]:
+        if path.exists():
+            result = json.loads(path.read_text())
+            evals[int(result["step"])] = (result["train"]["value"], result["test"]["value"])
     return {"dir": str(run_dir), "config": config, "steps": np.array(steps), "values": np.array(values), "evals": evals}
 
 

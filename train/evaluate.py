@@ -27,18 +27,20 @@ EVAL_CONFIGS = 64
 PLAYS_PER_CONFIG = 2
 
 
-def play_split(agent: Agent, args: Args, split: str, num_envs: int, device: torch.device, seed: int = 0) -> dict:
-    """Plays each of ``EVAL_CONFIGS`` configurations of ``split`` twice, greedily."""
-    if EVAL_CONFIGS % num_envs:
-        raise ValueError(f"num_envs must divide {EVAL_CONFIGS}, got {num_envs}")
+def play_split(agent: Agent, args: Args, split: str, num_envs: int, device: torch.device, seed: int = 0,
+               num_configs: int | None = None) -> dict:
+    """Plays each of the first ``num_configs`` (default ``EVAL_CONFIGS``) configurations of ``split`` twice, greedily."""
+    num_configs = num_configs or EVAL_CONFIGS
+    if num_configs % num_envs:
+        raise ValueError(f"num_envs must divide {num_configs}, got {num_envs}")
     # Env i starts at configuration i * 64 / num_envs and cycles, so its first
     # 2 * 64 / num_envs episodes cover its block and the next: every
     # configuration exactly twice.
-    per_env = PLAYS_PER_CONFIG * EVAL_CONFIGS // num_envs
+    per_env = PLAYS_PER_CONFIG * num_configs // num_envs
     task_kwargs = {k: v for k, v in args.task_kwargs().items() if k != "num_configs"}
     envs = MazeVectorEnv(
         num_envs, args.scenario, autoreset_mode="same_step", copy=False, split=split,
-        num_configs=EVAL_CONFIGS, config_sampling="cycle", **task_kwargs,
+        num_configs=num_configs, config_sampling="cycle", **task_kwargs,
     )
     metric, scale, _ = PAPER_METRIC[args.scenario]
     episodes: list[list[dict]] = [[] for _ in range(num_envs)]
@@ -71,10 +73,11 @@ def play_split(agent: Agent, args: Args, split: str, num_envs: int, device: torc
 
 
 def evaluate(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | None = None, num_envs: int = 16,
-             device: str = "auto", out: str | pathlib.Path | None = None) -> dict:
+             device: str = "auto", out: str | pathlib.Path | None = None, num_configs: int | None = None) -> dict:
     """Evaluates a run's checkpoint (default: its latest) on train and test.
 
-    Writes the result to ``out`` (default: the run's ``eval.json``).
+    ``num_configs`` configurations per split (default ``EVAL_CONFIGS`` = 64),
+    each played twice. Writes the result to ``out`` (default: the run's ``eval.json``).
     """
     torch_device = pick_device(device)
     args, agent, state = policy.load_run(run_dir, checkpoint_path, torch_device)
@@ -87,7 +90,7 @@ def evaluate(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | 
         "units": PAPER_METRIC[args.scenario][2],
     }
     for split in ("train", "test"):
-        result[split] = play_split(agent, args, split, num_envs, torch_device)
+        result[split] = play_split(agent, args, split, num_envs, torch_device, num_configs=num_configs)
     checkpoint.atomic_write_json(pathlib.Path(out) if out else pathlib.Path(run_dir) / "eval.json", result)
     return result
 

@@ -1,0 +1,221 @@
+"""The paper's experiment grid on Ray: one training run per (scenario, difficulty, seed), each then evaluated.
+
+    python -m train.sweep --grid small --total-steps 1000000     # Labyrinth 5 and 7 x 2 seeds
+    python -m train.sweep --grid paper                           # Table 2: 4 scenarios x 4 difficulties x 3 seeds, 200M steps
+    python -m train.sweep --grid generalisation                  # Labyrinth 9 with 16/64/256/1024 training mazes x 3 seeds
+    python -m train.sweep --grid custom --scenario k_item --difficulties 2 4 --seeds 0 1
+    python -m train.sweep --grid paper --address auto --cpus-per-run 4 --gpus-per-run 0.25   # an existing cluster
+    python -m train.report sweeps/paper                          # the table and curves
+
+Each run is a Ray task (local Ray by default; ``--address`` joins a cluster,
+whose nodes need mjmaze installed and a shared ``--sweeps-dir``) holding
+``--cpus-per-run`` CPUs (its env workers) and ``--gpus-per-run`` of a GPU.
+Everything lands in ``sweeps/<name>/``: ``sweep.json`` (the grid and flags) and
+one run folder per run, laid out as ``train.a2c`` does, with ``eval.json``
+(``train.evaluate``) written as the run ends.
+
+**Resumable**: run the same command again. A run whose ``eval.json`` covers
+the full ``--total-steps`` is never redone; a crashed or killed one goes on from
+its last checkpoint (lines it logged after that checkpoint are dropped); a run
+that never checkpointed starts over. Ray retries a task whose worker died
+(``--retries``), from its checkpoint too.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import os
+import pathlib
+import sys
+import time
+
+from train import a2c, checkpoint, evaluate
+
+# The task argument that sets each scenario's difficulty in the paper's Table 2.
+DIFFICULTY = {"labyrinth": "size", "find_return": "size", "k_item": "num_items", "two_colour": "complexity"}
+PAPER_DIFFICULTIES = {"labyrinth": (7, 9, 11, 13), "find_return": (7, 9, 11, 13), "k_item": (2, 4, 6, 8),
+                      "two_colour": (1, 3, 5, 7)}
+GENERALISATION_CONFIGS = (16, 64, 256, 1024)
+# The generalisation study's maze size: the paper does not state it; Labyrinth's default.
+GENERALISATION_SIZE = 9
+GRIDS = ("paper", "generalisation", "small", "custom")
+DEFAULT_STEPS = {"paper": 200_000_000, "generalisation": 200_000_000, "small": 1_000_000, "custom": 10_000_000}
+
+
+@dataclasses.dataclass(frozen=True)
+class RunSpec:
+    """One run of a grid."""
+
+    scenario: str
+    difficulty: int
+    seed: int
+    num_configs: int | None = None
+
+    @property
+    def name(self) -> str:
+        configs = f"_n{self.num_configs}" if self.num_configs else ""
+        return f"{self.scenario}_{DIFFICULTY[self.scenario]}{self.difficulty}{configs}_s{self.seed}"
+
+    def args(self, settings: dict, runs_dir: pathlib.Path) -> a2c.Args:
+        """The training flags of this run: ``settings`` (shared by the sweep) plus its own."""
+        return a2c.Args(**{
+            **settings, "scenario": self.scenario, DIFFICULTY[self.scenario]: self.difficulty, "seed": self.seed,
+            "num_configs": self.num_configs, "runs_dir": str(runs_dir), "run_name": self.name, "progress": False,
+        })
+
+
+def grid(name: str, seeds: list[int] | None = None, scenario: str | None = None,
+         difficulties: list[int] | None = None, num_configs: list[int] | None = None) -> list[RunSpec]:
+    """The runs of grid ``name``; ``seeds`` overrides the grid's, the rest define ``custom``."""
+    if name == "paper":
+        seeds = seeds or [0, 1, 2]
+        return [RunSpec(s, d, seed) for s, ds in PAPER_DIFFICULTIES.items() for d in ds for seed in seeds]
+    if name == "generalisation":
+        seeds = seeds or [0, 1, 2]
+        return [RunSpec("labyrinth", GENERALISATION_SIZE, seed, n) for n in GENERALISATION_CONFIGS for seed in seeds]
+    if name == "small":
+        seeds = seeds or [0, 1]
+        return [RunSpec("labyrinth", d, seed) for d in (5, 7) for seed in seeds]
+    if name == "custom":
+        if scenario not in DIFFICULTY or not difficulties:
+            raise ValueError(f"--grid custom needs --scenario (one of {tuple(DIFFICULTY)}) and --difficulties")
+        seeds = seeds or [0]
+        return [RunSpec(scenario, d, seed, n) for d in difficulties for n in (num_configs or [None]) for seed in seeds]
+    raise ValueError(f"unknown grid {name!r}; choose one of {GRIDS}")
+
+
+def finished(run_dir: pathlib.Path, total_steps: int) -> dict | None:
+    """The run's evaluation if it covers ``total_steps``, else None."""
+    try:
+        result = json.loads((run_dir / "eval.json").read_text())
+    except (FileNotFoundError, json.JSONDecodeError):
+        return None
+    return result if result.get("step", 0) >= total_steps else None
+
+
+def run_one(spec: RunSpec, settings: dict, sweep_dir: str, eval_envs: int, eval_configs: int) -> dict:
+    """Trains (or resumes) one run, then evaluates it; what a Ray task runs."""
+    args = spec.args(settings, pathlib.Path(sweep_dir))
+    run_dir = pathlib.Path(sweep_dir) / spec.name
+    done = finished(run_dir, args.total_steps)
+    if done is not None:
+        return {"name": spec.name, "status": "already finished", "eval": done}
+    found = checkpoint.checkpoints(run_dir / "checkpoints")
+    resumed_from = checkpoint.load(found[-1], dataclasses.asdict(args))["step"] if found else 0
+    if resumed_from < args.total_steps:
+        a2c.train(dataclasses.replace(args, resume=bool(found)))
+    result = evaluate.evaluate(run_dir, num_envs=eval_envs, num_configs=eval_configs)
+    status = f"resumed from step {resumed_from:,}" if found else "trained"
+    return {"name": spec.name, "status": status, "eval": result}
+
+
+def launch(specs: list[RunSpec], sweep_dir: pathlib.Path, settings: dict, *, address: str | None = None,
+           num_cpus: int | None = None, cpus_per_run: int = 2, gpus_per_run: float = 0.0, retries: int = 1,
+           eval_envs: int = 16, eval_configs: int = evaluate.EVAL_CONFIGS, log=print) -> list[dict]:
+    """Runs ``specs`` on Ray (skipping finished runs); returns one result per run, finished ones included."""
+    import ray
+
+    sweep_dir = pathlib.Path(sweep_dir).resolve()  # Ray workers do not share the driver's working directory
+    total_steps = settings["total_steps"]
+    results, todo = [], []
+    for spec in specs:
+        done = finished(sweep_dir / spec.name, total_steps)
+        if done is not None:
+            results.append({"name": spec.name, "status": "already finished", "eval": done})
+            log(f"[sweep] {spec.name}: already finished (step {done['step']:,}), skipped")
+        else:
+            todo.append(spec)
+    if not todo:
+        return results
+    if address is None:
+        cores = num_cpus or os.cpu_count() or 1
+        if cpus_per_run > cores:
+            raise ValueError(f"--cpus-per-run {cpus_per_run} is more than the {cores} CPUs local Ray has: no run could start")
+        ray.init(num_cpus=num_cpus, include_dashboard=False, log_to_driver=False, configure_logging=False)
+    else:
+        ray.init(address=address, log_to_driver=False, configure_logging=False)
+    try:
+        remote = ray.remote(num_cpus=cpus_per_run, num_gpus=gpus_per_run, max_retries=retries)(run_one)
+        pending = {remote.remote(spec, settings, str(sweep_dir), eval_envs, eval_configs): spec for spec in todo}
+        log(f"[sweep] {len(todo)} run(s) submitted, {len(results)} already finished; {sweep_dir}")
+        start = time.monotonic()
+        while pending:
+            (ready,), _ = ray.wait(list(pending), num_returns=1)
+            spec = pending.pop(ready)
+            try:
+                result = ray.get(ready)
+            except Exception as error:  # one failed run must not stop the others
+                result = {"name": spec.name, "status": f"failed: {type(error).__name__}: {error}".splitlines()[0]}
+                log(f"[sweep] {spec.name}: {result['status']}")
+            else:
+                e = result["eval"]
+                log(f"[sweep] {spec.name}: {result['status']}; {e['units']} train {e['train']['value']:.3g} "
+                    f"test {e['test']['value']:.3g} ({time.monotonic() - start:.0f} s, {len(pending)} left)")
+            results.append(result)
+    finally:
+        ray.shutdown()
+    return results
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--grid", default="small", choices=GRIDS)
+    parser.add_argument("--name", default=None, help="the sweep's folder under --sweeps-dir (default: the grid's name)")
+    parser.add_argument("--sweeps-dir", type=pathlib.Path, default=pathlib.Path("sweeps"))
+    parser.add_argument("--seeds", type=int, nargs="+", default=None, help="default: 0 1 2 (paper), 0 1 (small)")
+    parser.add_argument("--scenario", default=None, help="--grid custom: the scenario")
+    parser.add_argument("--difficulties", type=int, nargs="+", default=None, help="--grid custom: sizes, K or c")
+    parser.add_argument("--num-configs", type=int, nargs="+", default=None, help="--grid custom: training set sizes")
+    parser.add_argument("--total-steps", type=int, default=None,
+                        help=f"agent steps per run (default: {DEFAULT_STEPS})")
+    parser.add_argument("--num-envs", type=int, default=a2c.Args.num_envs)
+    parser.add_argument("--num-steps", type=int, default=a2c.Args.num_steps)
+    parser.add_argument("--checkpoint-every", type=int, default=None, help="default: total steps / 20")
+    parser.add_argument("--device", default="auto", help="auto (CUDA where Ray gives the task a GPU), cpu, cuda")
+    parser.add_argument("--address", default=None, help="an existing Ray cluster ('auto' or host:port)")
+    parser.add_argument("--num-cpus", type=int, default=None, help="local Ray: CPUs to use (default: all)")
+    parser.add_argument("--cpus-per-run", type=int, default=2, help="CPUs per run (its env workers)")
+    parser.add_argument("--gpus-per-run", type=float, default=0.0, help="fraction of a GPU per run")
+    parser.add_argument("--retries", type=int, default=1, help="Ray retries of a run whose worker died")
+    parser.add_argument("--eval-envs", type=int, default=16, help="parallel envs for the evaluation")
+    parser.add_argument("--eval-configs", type=int, default=evaluate.EVAL_CONFIGS,
+                        help="configurations per split in the evaluation, each played twice (paper: 64)")
+    args = parser.parse_args(argv)
+    try:
+        specs = grid(args.grid, args.seeds, args.scenario, args.difficulties, args.num_configs)
+    except ValueError as error:
+        raise SystemExit(f"error: {error}") from None
+    total_steps = args.total_steps or DEFAULT_STEPS[args.grid]
+    settings = {
+        "total_steps": total_steps, "num_envs": args.num_envs, "num_steps": args.num_steps, "device": args.device,
+        "checkpoint_every": args.checkpoint_every or max(args.num_envs * args.num_steps, total_steps // 20),
+        "num_workers": args.cpus_per_run, "torch_threads": args.cpus_per_run,
+    }
+    try:
+        for spec in specs:
+            spec.args(settings, args.sweeps_dir).task_kwargs()  # every run's flags are valid before anything starts
+    except ValueError as error:
+        raise SystemExit(f"error: {error}") from None
+    sweep_dir = args.sweeps_dir / (args.name or args.grid)
+    checkpoint.atomic_write_json(sweep_dir / "sweep.json", {
+        "grid": args.grid, "runs": [s.name for s in specs], "settings": settings, "command": sys.argv,
+        "eval_configs": args.eval_configs,
+    })
+    try:
+        results = launch(specs, sweep_dir, settings, address=args.address, num_cpus=args.num_cpus,
+                         cpus_per_run=args.cpus_per_run, gpus_per_run=args.gpus_per_run, retries=args.retries,
+                         eval_envs=args.eval_envs, eval_configs=args.eval_configs)
+    except ValueError as error:
+        raise SystemExit(f"error: {error}") from None
+    failed = [r for r in results if r["status"].startswith("failed")]
+    print(f"[sweep] {len(results) - len(failed)}/{len(results)} runs finished in {sweep_dir}; "
+          f"table: python -m train.report {sweep_dir}")
+    if failed:
+        raise SystemExit(f"error: {len(failed)} run(s) failed: {', '.join(r['name'] for r in failed)}; "
+                         "run the same command again to resume them")
+
+
+if __name__ == "__main__":
+    main()
