@@ -31,6 +31,7 @@ import pathlib
 import sys
 import time
 
+from mjmaze import suite
 from train import a2c, checkpoint, evaluate
 
 # The task argument that sets each scenario's difficulty in the paper's Table 2.
@@ -195,7 +196,8 @@ def main(argv: list[str] | None = None) -> None:
     }
     try:
         for spec in specs:
-            spec.args(settings, args.sweeps_dir).task_kwargs()  # every run's flags are valid before anything starts
+            # Every run's task is valid before anything starts.
+            suite.make_task(spec.scenario, spec.args(settings, args.sweeps_dir).task_kwargs())
     except ValueError as error:
         raise SystemExit(f"error: {error}") from None
     sweep_dir = args.sweeps_dir / (args.name or args.grid)

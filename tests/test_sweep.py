@@ -1,0 +1,87 @@
+"""The experiment grid: what each grid holds, and a tiny grid on local Ray that is killed, resumed and reported."""
+
+import csv
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from train import report, sweep
+
+
+def test_the_paper_grid_is_table_2():
+    runs = sweep.grid("paper")
+    assert len(runs) == 48 and len({r.name for r in runs}) == 48
+    assert sorted({(r.scenario, r.difficulty) for r in runs}) == sorted(report.PAPER_TABLE2)
+    assert {r.seed for r in runs} == {0, 1, 2}
+
+
+def test_the_generalisation_grid_varies_the_training_set():
+    runs = sweep.grid("generalisation", seeds=[0, 1])
+    assert sorted({r.num_configs for r in runs}) == [16, 64, 256, 1024] and len(runs) == 8
+    assert {r.scenario for r in runs} == {"labyrinth"}
+    args = runs[0].args({"total_steps": 100}, "sweeps/g")
+    assert args.task_kwargs()["num_configs"] == runs[0].num_configs
+
+
+def test_a_custom_grid_needs_a_scenario_and_difficulties():
+    assert [r.name for r in sweep.grid("custom", [3], "k_item", [2, 4])] == ["k_item_num_items2_s3", "k_item_num_items4_s3"]
+    with pytest.raises(ValueError, match="--difficulties"):
+        sweep.grid("custom", scenario="k_item")
+    with pytest.raises(SystemExit, match="size must be one of"):
+        sweep.main(["--grid", "custom", "--scenario", "labyrinth", "--difficulties", "6"])
+
+
+def _sweep_command(tmp_path):
+    return [
+        sys.executable, "-m", "train.sweep", "--grid", "custom", "--scenario", "two_colour", "--difficulties", "1",
+        "--seeds", "0", "1", "--total-steps", "960", "--num-envs", "2", "--num-steps", "8", "--checkpoint-every", "64",
+        "--eval-configs", "2", "--eval-envs", "2", "--num-cpus", "2", "--cpus-per-run", "2",
+        "--sweeps-dir", str(tmp_path), "--name", "tiny",
+    ]
+
+
+def test_a_tiny_grid_survives_a_kill_resumes_without_redoing_and_reports(tmp_path):
+    first, second = tmp_path / "tiny" / "two_colour_complexity1_s0", tmp_path / "tiny" / "two_colour_complexity1_s1"
+    # 1. Start the grid (runs one at a time on 2 CPUs) and kill everything once the first run has
+    #    finished and the second has a checkpoint but no evaluation.
+    process = subprocess.Popen(_sweep_command(tmp_path), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                               start_new_session=True)
+    deadline = time.monotonic() + 240
+    while not ((first / "eval.json").exists() and list((second / "checkpoints").glob("*.pt"))):
+        assert process.poll() is None and time.monotonic() < deadline, process.stdout.read()
+        time.sleep(0.02)
+    os.killpg(process.pid, signal.SIGKILL)
+    process.wait(timeout=30)
+    assert not (second / "eval.json").exists(), "the second run finished before the kill; make it longer"
+    finished_at = (first / "eval.json").stat().st_mtime_ns
+
+    # 2. The same command again: the finished run is skipped, the killed one goes on from its checkpoint.
+    rerun = subprocess.run(_sweep_command(tmp_path), capture_output=True, text=True, timeout=300)
+    assert rerun.returncode == 0, rerun.stdout + rerun.stderr
+    assert "two_colour_complexity1_s0: already finished (step 960), skipped" in rerun.stdout
+    assert "two_colour_complexity1_s1: resumed from step" in rerun.stdout
+    assert "resumed from step 0" not in rerun.stdout
+    assert (first / "eval.json").stat().st_mtime_ns == finished_at
+    steps = [json.loads(line)["step"] for line in (second / "metrics.jsonl").read_text().splitlines()]
+    assert steps == list(range(16, 961, 16))  # no step logged twice across the kill
+    assert json.loads((second / "eval.json").read_text())["step"] == 960
+
+    # 3. The report: one row for the two seeds, the paper's numbers beside ours, the curves.
+    report.main([str(tmp_path / "tiny")])
+    with open(tmp_path / "tiny" / "report.csv") as f:
+        (row,) = list(csv.DictReader(f))
+    assert (row["scenario"], row["difficulty"], row["seeds"], row["evaluated"]) == ("two_colour", "1", "2", "2")
+    assert 0 < float(row["test_mean"]) <= 2100 and row["paper_test_mean"] == "1941"
+    text = (tmp_path / "tiny" / "report.md").read_text()
+    assert "| 1 | 2 | " in text and "1941 ± 4" in text
+    assert (tmp_path / "tiny" / "curves_two_colour.png").stat().st_size > 1000
+
+
+def test_report_of_a_folder_without_runs_is_one_clear_error(tmp_path):
+    with pytest.raises(SystemExit, match="no run folders"):
+        report.main([str(tmp_path)])

@@ -1,0 +1,156 @@
+"""The results table of a sweep, in the layout of the paper's Table 2, with the paper's numbers beside ours.
+
+    python -m train.report sweeps/paper
+
+Reads every run folder of the sweep (``config.json``, ``eval.json``,
+``metrics.jsonl``), groups the seeds of each (scenario, difficulty, training
+set size), and writes into the sweep folder (or ``--out``):
+
+- ``report.md``: one table per scenario: mean +- std over seeds (population
+  std) of the greedy evaluation on the training and test configurations, in
+  the paper's units (success %, items in order / K, tics survived), the agent
+  steps trained, and the paper's Table 2 (200M steps, 3 seeds) beside it;
+- ``report.csv``: the same rows, one column per number;
+- ``curves_<scenario>.png`` (+ ``.json``): the learning curves of each scenario
+  (``train.curves``), seeds averaged.
+
+Runs without ``eval.json`` yet (still training, or killed) are listed as such.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import json
+import pathlib
+
+import numpy as np
+
+from train import checkpoint, curves
+from train.a2c import PAPER_METRIC
+from train.sweep import DIFFICULTY
+
+# The paper's Table 2: (scenario, difficulty) -> (train mean, train std, test mean, test std).
+PAPER_TABLE2 = {
+    ("labyrinth", 7): (99.8, 0.2, 99.5, 0.2), ("labyrinth", 9): (98.1, 0.8, 97.4, 1.3),
+    ("labyrinth", 11): (95.2, 0.7, 90.1, 1.0), ("labyrinth", 13): (84.1, 1.8, 79.8, 1.9),
+    ("find_return", 7): (98.7, 0.3, 95.1, 0.2), ("find_return", 9): (87.0, 1.9, 81.6, 1.8),
+    ("find_return", 11): (70.9, 1.6, 64.0, 1.6), ("find_return", 13): (57.7, 0.8, 52.9, 3.7),
+    ("k_item", 2): (0.968, 0.004, 0.932, 0.012), ("k_item", 4): (0.910, 0.012, 0.861, 0.015),
+    ("k_item", 6): (0.577, 0.024, 0.522, 0.023), ("k_item", 8): (0.084, 0.071, 0.083, 0.070),
+    ("two_colour", 1): (1903, 27, 1941, 4), ("two_colour", 3): (1789, 24, 1781, 24),
+    ("two_colour", 5): (1436, 158, 1432, 161), ("two_colour", 7): (1159, 126, 1128, 140),
+}
+PAPER_STEPS = 200_000_000
+CSV_FIELDS = ("scenario", "difficulty_name", "difficulty", "num_configs", "units", "seeds", "evaluated", "steps",
+              "episodes",
+              "train_mean", "train_std", "test_mean", "test_std",
+              "paper_train_mean", "paper_train_std", "paper_test_mean", "paper_test_std")
+
+
+def collect(sweep_dir: pathlib.Path) -> tuple[list[dict], list[pathlib.Path]]:
+    """One row per (scenario, difficulty, training set size), and the run folders found."""
+    run_dirs = sorted(p for p in sweep_dir.iterdir() if (p / "config.json").exists())
+    if not run_dirs:
+        raise FileNotFoundError(f"no run folders (with config.json) in {sweep_dir}")
+    groups: dict[tuple, list[tuple[dict, dict | None]]] = {}
+    for run_dir in run_dirs:
+        config = json.loads((run_dir / "config.json").read_text())
+        eval_file = run_dir / "eval.json"
+        result = json.loads(eval_file.read_text()) if eval_file.exists() else None
+        scenario = config["scenario"]
+        key = (scenario, config.get(DIFFICULTY[scenario]), config.get("num_configs"))
+        groups.setdefault(key, []).append((config, result))
+    rows = []
+    for (scenario, difficulty, num_configs), runs in sorted(groups.items(), key=lambda kv: _order(kv[0])):
+        evaluated = [r for _, r in runs if r is not None]
+        train = np.array([r["train"]["value"] for r in evaluated])
+        test = np.array([r["test"]["value"] for r in evaluated])
+        paper = PAPER_TABLE2.get((scenario, difficulty)) if num_configs is None else None
+        rows.append({
+            "scenario": scenario, "difficulty_name": DIFFICULTY[scenario], "difficulty": difficulty,
+            "num_configs": num_configs, "units": PAPER_METRIC[scenario][2], "seeds": len(runs),
+            "evaluated": len(evaluated), "steps": min((r["step"] for r in evaluated), default=None),
+            "episodes": min((r["test"]["episodes"] for r in evaluated), default=None),
+            "train_mean": float(train.mean()) if len(train) else None,
+            "train_std": float(train.std()) if len(train) else None,
+            "test_mean": float(test.mean()) if len(test) else None,
+            "test_std": float(test.std()) if len(test) else None,
+            **dict(zip(("paper_train_mean", "paper_train_std", "paper_test_mean", "paper_test_std"),
+                       paper or (None,) * 4)),
+        })
+    return rows, run_dirs
+
+
+def _order(key: tuple) -> tuple:
+    scenario, difficulty, num_configs = key
+    return (list(DIFFICULTY).index(scenario), difficulty or 0, num_configs or 0)
+
+
+def _cell(mean, std, scenario: str) -> str:
+    if mean is None:
+        return "-"
+    digits = 3 if scenario == "k_item" else (0 if scenario == "two_colour" else 1)
+    return f"{mean:.{digits}f} ± {std:.{digits}f}"
+
+
+def markdown(rows: list[dict], sweep_dir: pathlib.Path) -> str:
+    episodes = sorted({r["episodes"] for r in rows if r["episodes"]})
+    lines = [f"# Results of `{sweep_dir}`", "",
+             f"Greedy evaluation (`train.evaluate`: {'/'.join(map(str, episodes)) or 'no'} episodes per split, each "
+             "configuration played twice); mean ± std over seeds. Paper: Table 2 of Beeching et al. (ViZDoom, "
+             f"{PAPER_STEPS // 1_000_000}M steps, 3 seeds).", ""]
+    for scenario in dict.fromkeys(r["scenario"] for r in rows):
+        units = PAPER_METRIC[scenario][2]
+        scenario_rows = [r for r in rows if r["scenario"] == scenario]
+        with_configs = any(r["num_configs"] for r in scenario_rows)
+        lines += [f"## {scenario} ({units})", ""]
+        header = [DIFFICULTY[scenario], *(["training mazes"] if with_configs else []), "seeds", "steps",
+                  "train", "test", "paper train", "paper test"]
+        lines += ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+        for r in scenario_rows:
+            seeds = f"{r['evaluated']}" + (f" (of {r['seeds']})" if r["evaluated"] < r["seeds"] else "")
+            steps = f"{r['steps'] / 1e6:.3g}M" if r["steps"] else "-"
+            cells = [str(r["difficulty"]), *([str(r["num_configs"] or 256)] if with_configs else []), seeds, steps,
+                     _cell(r["train_mean"], r["train_std"], scenario), _cell(r["test_mean"], r["test_std"], scenario),
+                     _cell(r["paper_train_mean"], r["paper_train_std"], scenario),
+                     _cell(r["paper_test_mean"], r["paper_test_std"], scenario)]
+            lines.append("| " + " | ".join(cells) + " |")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def report(sweep_dir: pathlib.Path, out: pathlib.Path | None = None) -> dict:
+    """Writes report.md, report.csv and the curves; returns the rows and the files written."""
+    out = out or sweep_dir
+    rows, run_dirs = collect(sweep_dir)
+    text = markdown(rows, sweep_dir)
+    checkpoint.atomic_write_bytes(out / "report.md", text.encode())
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=CSV_FIELDS)
+    writer.writeheader()
+    writer.writerows(rows)
+    checkpoint.atomic_write_bytes(out / "report.csv", buffer.getvalue().encode())
+    files = [out / "report.md", out / "report.csv"]
+    for scenario in dict.fromkeys(r["scenario"] for r in rows):
+        dirs = [d for d in run_dirs if json.loads((d / "config.json").read_text())["scenario"] == scenario]
+        files.append(curves.write(curves.curves(dirs), out / f"curves_{scenario}.png", title=str(sweep_dir)))
+    return {"rows": rows, "markdown": text, "files": [str(f) for f in files]}
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("sweep_dir", type=pathlib.Path)
+    parser.add_argument("--out", type=pathlib.Path, default=None, help="default: the sweep folder")
+    args = parser.parse_args(argv)
+    try:
+        result = report(args.sweep_dir, args.out)
+    except FileNotFoundError as error:
+        raise SystemExit(f"error: {error}") from None
+    print(result["markdown"])
+    print("written: " + ", ".join(result["files"]))
+
+
+if __name__ == "__main__":
+    main()
