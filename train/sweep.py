@@ -148,7 +148,8 @@ def launch(specs: list[RunSpec], sweep_dir: pathlib.Path, settings: dict, *, add
             try:
                 result = ray.get(ready)
             except Exception as error:  # one failed run must not stop the others
-                result = {"name": spec.name, "status": f"failed: {type(error).__name__}: {error}".splitlines()[0]}
+                cause = getattr(error, "cause", None) or error  # a RayTaskError wraps the run's own exception
+                result = {"name": spec.name, "status": f"failed: {type(cause).__name__}: {cause}".splitlines()[0]}
                 log(f"[sweep] {spec.name}: {result['status']}")
             else:
                 e = result["eval"]
