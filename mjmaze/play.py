@@ -77,7 +77,7 @@ class PlaySession:
         field, scale, units = suite.PAPER_METRIC[self.scenario]
         self.episodes.append({
             "config_index": info["config_index"], "steps": info["step"], "return": self.episode_return,
-            units: float(info[field]) * scale, "finished": bool(self.timestep.last()),
+            "metric": float(info[field]) * scale, "metric_units": units, "finished": bool(self.timestep.last()),
         })
         self._new_episode()
 

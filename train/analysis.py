@@ -150,10 +150,10 @@ def analyse(source_args: argparse.Namespace, episodes: int, out: pathlib.Path | 
     summary = {
         "source": source_args.source, "description": description, "scenario": scenario, "task_kwargs": task_kwargs,
         "split": source_args.split, "states": len(hidden), "tsne_points": len(embedding),
-        "landmark": policy.LANDMARK[scenario],
+        "landmark": policy.LANDMARK[scenario], "metric_units": units,
         "episodes": [
             {"config_index": e.config_index, "length": e.length, "return": float(e.rewards.sum()),
-             units: float(e.infos[-1][field]) * scale, "landmark_first_seen": e.landmark_first_seen,
+             "metric": float(e.infos[-1][field]) * scale, "landmark_first_seen": e.landmark_first_seen,
              **({"totem_green": bool(e.infos[0]["totem_green"])} if scenario == "two_colour" else {})}
             for e in played
         ],

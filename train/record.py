@@ -78,9 +78,9 @@ def record(source_args: argparse.Namespace, episodes: int, out: pathlib.Path, fp
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.stem}.tmp{path.suffix}")
     header = f"{description} | {scenario} {task_kwargs} | {source_args.split}"
-    summary = {"video": str(path), "source": source_args.source, "scenario": scenario, "task_kwargs": task_kwargs,
-               "split": source_args.split, "fps": fps, "frames": 0, "episodes": []}
     field, scale, units = PAPER_METRIC[scenario]
+    summary = {"video": str(path), "source": source_args.source, "scenario": scenario, "task_kwargs": task_kwargs,
+               "split": source_args.split, "fps": fps, "frames": 0, "metric_units": units, "episodes": []}
     try:
         writer = _writer(tmp, fps)
         try:
@@ -95,7 +95,7 @@ def record(source_args: argparse.Namespace, episodes: int, out: pathlib.Path, fp
                 final = episode.infos[-1] if episode.infos else {field: 0}
                 summary["episodes"].append({
                     "config_index": episode.config_index, "length": episode.length,
-                    "return": float(episode.rewards.sum()), units: float(final[field]) * scale,
+                    "return": float(episode.rewards.sum()), "metric": float(final[field]) * scale,
                     "path": np.round(episode.poses, 4).tolist(),
                 })
         finally:
@@ -123,10 +123,10 @@ def main(argv: list[str] | None = None) -> None:
         summary = record(args, args.episodes, args.out, args.fps, args.max_steps)
     except (checkpoint.CheckpointError, FileNotFoundError, ValueError) as error:
         raise SystemExit(f"error: {error}") from None
-    units = PAPER_METRIC[summary["scenario"]][2]
+    units = summary["metric_units"]
     for k, e in enumerate(summary["episodes"]):
         print(f"episode {k + 1}: config {e['config_index']}, {e['length']} steps, return {e['return']:+.3f}, "
-              f"{units} {e[units]:.3g}")
+              f"{units} {e['metric']:.3g}")
     print(f"written: {summary['video']} ({summary['frames']} frames), {pathlib.Path(summary['video']).with_suffix('.json')}")
 
 
