@@ -136,7 +136,7 @@ def line_of_sight(config: configs.MazeConfig, start, end) -> bool:
         for j in range(max(first, 0), min(last, n) + 1):
             t = ((j - 0.5 - half) * cell - a0) / (a1 - a0)
             b = b0 + t * (b1 - b0)
-            i = int(round(b / cell + half))
+            i = round(b / cell + half)
             if 0 <= i < n and walls[i, j]:
                 return False
     return True

@@ -7,12 +7,11 @@ import os
 import imageio.v3 as iio
 import numpy as np
 import pytest
+from conftest import find_cell, open_run, place
 
 import mjmaze
 from mjmaze import maze, play, viz
 from mjmaze.tasks import base
-
-from conftest import find_cell, open_run, place
 
 
 @pytest.fixture

@@ -15,7 +15,6 @@ path. Both are written to temporary files and renamed into place.
 from __future__ import annotations
 
 import argparse
-import json
 import pathlib
 
 import imageio.v2 as imageio

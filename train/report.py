@@ -97,10 +97,10 @@ def _cell(mean, std, scenario: str) -> str:
 
 def markdown(rows: list[dict], sweep_dir: pathlib.Path) -> str:
     episodes = sorted({r["episodes"] for r in rows if r["episodes"]})
-    lines = [f"# Results of `{sweep_dir}`", "",
-             f"Greedy evaluation (`train.evaluate`: {'/'.join(map(str, episodes)) or 'no'} episodes per split, each "
+    intro = (f"Greedy evaluation (`train.evaluate`: {'/'.join(map(str, episodes)) or 'no'} episodes per split, each "
              "configuration played twice); mean ± std over seeds. Paper: Table 2 of Beeching et al. (ViZDoom, "
-             f"{PAPER_STEPS // 1_000_000}M steps, 3 seeds).", ""]
+             f"{PAPER_STEPS // 1_000_000}M steps, 3 seeds).")
+    lines = [f"# Results of `{sweep_dir}`", "", intro, ""]
     for scenario in dict.fromkeys(r["scenario"] for r in rows):
         units = PAPER_METRIC[scenario][2]
         scenario_rows = [r for r in rows if r["scenario"] == scenario]
