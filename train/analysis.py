@@ -10,7 +10,8 @@ configurations, records the GRU state after every frame, and writes into
 - ``states.npz``: every recorded state with its episode, step, pose, and, per
   episode, the step at which the landmark (Two-colour's totem, Labyrinth's exit,
   Find-and-return's red pillar, K-item's first item) first came into view;
-- ``heatmap.png``: the 128 activations of episode 0 over time, that step marked;
+- ``heatmap.png``: the 128 activations of one episode (``--heatmap-episode``,
+  default the longest) over time, that step marked;
 - ``tsne.png`` and ``tsne.npz``: a t-SNE (scikit-learn) of up to
   ``--tsne-states`` states drawn evenly from all episodes, coloured by time step,
   with up to 20 episodes drawn as lines; for Two-colour a second panel coloured
@@ -113,7 +114,7 @@ def tsne_figure(embedding: np.ndarray, steps: np.ndarray, episode_of: np.ndarray
 
 
 def analyse(source_args: argparse.Namespace, episodes: int, out: pathlib.Path | None = None,
-            tsne_states: int = TSNE_STATES, max_steps: int | None = None) -> dict:
+            tsne_states: int = TSNE_STATES, max_steps: int | None = None, heatmap_episode: int | None = None) -> dict:
     """Records states, writes the files listed in the module docstring; returns the summary."""
     scenario, task_kwargs, description, played = record_states(source_args, episodes, max_steps)
     if out is None:
@@ -136,7 +137,13 @@ def analyse(source_args: argparse.Namespace, episodes: int, out: pathlib.Path | 
     np.savez_compressed(buffer, hidden=hidden, episode=episode_of, step=steps, pose=poses,
                         landmark_first_seen=first_seen, **({"totem_green": totem_green} if totem_green is not None else {}))
     checkpoint.atomic_write_bytes(out / "states.npz", buffer.getvalue())
-    save_figure(heatmap(played[0], scenario, f"episode 0 ({played[0].length} steps) - {title}"), out / "heatmap.png")
+    if heatmap_episode is None:  # the longest episode shows the most
+        heatmap_episode = int(np.argmax([e.length for e in played]))
+    if not 0 <= heatmap_episode < len(played):
+        raise ValueError(f"--heatmap-episode must be in 0..{len(played) - 1}, got {heatmap_episode}")
+    shown = played[heatmap_episode]
+    save_figure(heatmap(shown, scenario, f"episode {heatmap_episode} ({shown.length} steps) - {title}"),
+                out / "heatmap.png")
 
     chosen = tsne_sample([e.length for e in played], tsne_states, source_args.seed)
     embedding = tsne(hidden[chosen], source_args.seed)
@@ -150,7 +157,7 @@ def analyse(source_args: argparse.Namespace, episodes: int, out: pathlib.Path | 
     summary = {
         "source": source_args.source, "description": description, "scenario": scenario, "task_kwargs": task_kwargs,
         "split": source_args.split, "states": len(hidden), "tsne_points": len(embedding),
-        "landmark": policy.LANDMARK[scenario], "metric_units": units,
+        "landmark": policy.LANDMARK[scenario], "metric_units": units, "heatmap_episode": heatmap_episode,
         "episodes": [
             {"config_index": e.config_index, "length": e.length, "return": float(e.rewards.sum()),
              "metric": float(e.infos[-1][field]) * scale, "landmark_first_seen": e.landmark_first_seen,
@@ -169,10 +176,11 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--episodes", type=int, default=20)
     parser.add_argument("--tsne-states", type=int, default=TSNE_STATES, help="states in the t-SNE")
     parser.add_argument("--max-steps", type=int, default=None, help="cut episodes after this many steps")
+    parser.add_argument("--heatmap-episode", type=int, default=None, help="episode of the heatmap (default: the longest)")
     parser.add_argument("--out", type=pathlib.Path, default=None, help="default: <run>/analysis")
     args = parser.parse_args(argv)
     try:
-        summary = analyse(args, args.episodes, args.out, args.tsne_states, args.max_steps)
+        summary = analyse(args, args.episodes, args.out, args.tsne_states, args.max_steps, args.heatmap_episode)
     except (checkpoint.CheckpointError, FileNotFoundError, ValueError) as error:
         raise SystemExit(f"error: {error}") from None
     seen = [e["landmark_first_seen"] for e in summary["episodes"] if e["landmark_first_seen"] is not None]
