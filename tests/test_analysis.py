@@ -107,3 +107,9 @@ def test_learning_curves_average_seeds_with_train_and_test_evaluations(tmp_path,
     for run in runs:
         assert sorted(p.name for p in (run / "evals").iterdir()) == ["step_000000000160.json", "step_000000000320.json"]
     picture(out)
+
+
+def test_tools_given_a_folder_that_is_no_run_say_so(tmp_path):
+    for tool in (curves.main, analysis.main):
+        with pytest.raises(SystemExit, match="no config.json"):
+            tool([str(tmp_path)])
