@@ -82,6 +82,11 @@ def test_a_tiny_grid_survives_a_kill_resumes_without_redoing_and_reports(tmp_pat
     assert (tmp_path / "tiny" / "curves_two_colour.png").stat().st_size > 1000
 
 
+def test_a_run_asking_for_a_gpu_ray_lacks_is_one_clear_error(tmp_path):
+    with pytest.raises(SystemExit, match="--gpus-per-run 64.0 is more than the"):
+        sweep.main(["--grid", "small", "--num-cpus", "2", "--gpus-per-run", "64", "--sweeps-dir", str(tmp_path)])
+
+
 def test_report_of_a_folder_without_runs_is_one_clear_error(tmp_path):
     with pytest.raises(SystemExit, match="no run folders"):
         report.main([str(tmp_path)])

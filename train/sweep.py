@@ -26,7 +26,6 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
-import os
 import pathlib
 import sys
 import time
@@ -131,13 +130,16 @@ def launch(specs: list[RunSpec], sweep_dir: pathlib.Path, settings: dict, *, add
     if not todo:
         return results
     if address is None:
-        cores = num_cpus or os.cpu_count() or 1
-        if cpus_per_run > cores:
-            raise ValueError(f"--cpus-per-run {cpus_per_run} is more than the {cores} CPUs local Ray has: no run could start")
         ray.init(num_cpus=num_cpus, include_dashboard=False, log_to_driver=False, configure_logging=False)
     else:
         ray.init(address=address, log_to_driver=False, configure_logging=False)
     try:
+        # A run asking for more than the cluster has would wait forever: say so now.
+        have = ray.cluster_resources()
+        for flag, asked, kind in (("--cpus-per-run", cpus_per_run, "CPU"), ("--gpus-per-run", gpus_per_run, "GPU")):
+            if asked > have.get(kind, 0):
+                raise ValueError(f"{flag} {asked} is more than the {have.get(kind, 0):g} {kind}(s) Ray has: "
+                                 "no run could start")
         remote = ray.remote(num_cpus=cpus_per_run, num_gpus=gpus_per_run, max_retries=retries)(run_one)
         pending = {remote.remote(spec, settings, str(sweep_dir), eval_envs, eval_configs): spec for spec in todo}
         log(f"[sweep] {len(todo)} run(s) submitted, {len(results)} already finished; {sweep_dir}")
