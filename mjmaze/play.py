@@ -21,7 +21,7 @@ import time
 import numpy as np
 
 import mjmaze
-from mjmaze import suite, viz
+from mjmaze import files, suite, viz
 from mjmaze.tasks import base
 
 STEPS_PER_SECOND = 35 / base.TICS_PER_STEP
@@ -98,13 +98,8 @@ class PlaySession:
 
     def save(self, out: pathlib.Path) -> None:
         """Writes ``session.json`` and ``screen.png`` into ``out`` (atomically)."""
-        import json
-
-        out.mkdir(parents=True, exist_ok=True)
         viz.save_png(out / "screen.png", self.screen())
-        tmp = out / ".session.json.tmp"
-        tmp.write_text(json.dumps(self.summary(), indent=2) + "\n")
-        tmp.replace(out / "session.json")
+        files.atomic_write_json(out / "session.json", self.summary())
 
     def close(self) -> None:
         self.top_down.close()
@@ -161,7 +156,7 @@ def run_window(session: PlaySession, max_frames: int | None = None) -> None:
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    viz.difficulty_arguments(parser)
+    suite.difficulty_arguments(parser)
     parser.add_argument("--split", default="train", choices=("train", "test"))
     parser.add_argument("--action-set", default="default", choices=tuple(base.ACTION_SETS))
     parser.add_argument("--seed", type=int, default=0)
@@ -171,7 +166,7 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     scenario = args.scenario or "labyrinth"
     out = args.out or pathlib.Path("runs/play") / f"{scenario}_{time.strftime('%Y%m%d-%H%M%S')}"
-    task_kwargs = {"split": args.split, "action_set": args.action_set, **viz.difficulty_kwargs(args)}
+    task_kwargs = {"split": args.split, "action_set": args.action_set, **suite.difficulty_kwargs(args)}
     try:
         session = PlaySession(scenario, task_kwargs, args.seed)
     except ValueError as error:

@@ -13,7 +13,7 @@ import time
 import numpy as np
 
 import mjmaze
-from mjmaze import render
+from mjmaze import files, render, suite
 
 
 def rollout(scenario: str, steps: int, seed: int, strip_frames: int, **task_kwargs) -> dict:
@@ -48,10 +48,7 @@ def rollout(scenario: str, steps: int, seed: int, strip_frames: int, **task_kwar
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--scenario", default="labyrinth", choices=mjmaze.ALL_TASKS)
-    parser.add_argument("--size", type=int, default=None, help="maze size n (Labyrinth, Find-and-return, K-item grid)")
-    parser.add_argument("--num-items", type=int, default=None, help="K (Ordered K-item)")
-    parser.add_argument("--complexity", type=int, default=None, help="c (Two-colour)")
+    suite.difficulty_arguments(parser)
     parser.add_argument("--split", default="train", choices=("train", "test"))
     parser.add_argument("--steps", type=int, default=5000, help="agent steps to run")
     parser.add_argument("--seed", type=int, default=0)
@@ -59,10 +56,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("runs/rollout/frames.png"))
     args = parser.parse_args(argv)
 
-    difficulty = {
-        key: value for key, value in (("size", args.size), ("num_items", args.num_items), ("complexity", args.complexity))
-        if value is not None
-    }
+    args.scenario = args.scenario or "labyrinth"
+    difficulty = suite.difficulty_kwargs(args)
     result = rollout(args.scenario, args.steps, args.seed, args.strip_frames, split=args.split, **difficulty)
     print(f"{args.scenario} {difficulty} ({args.split}), random policy, {args.steps} agent steps")
     print(f"  episodes finished : {result['episodes']}")
@@ -73,11 +68,8 @@ def main(argv: list[str] | None = None) -> None:
 
     import imageio.v3 as iio  # only needed for the picture
 
-    args.out.parent.mkdir(parents=True, exist_ok=True)
     strip = np.concatenate(result["frames"], axis=1)
-    tmp = args.out.with_suffix(".tmp.png")
-    iio.imwrite(tmp, strip)
-    tmp.replace(args.out)  # never leave a half-written picture
+    files.atomic_write_bytes(args.out, iio.imwrite("<bytes>", strip, extension=".png"))
     print(f"  frames            : {args.out} ({strip.shape[1]}x{strip.shape[0]})")
 
 

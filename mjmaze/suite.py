@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import inspect
 
 from dm_control.rl import control
@@ -59,6 +60,22 @@ def load(name: str, task_kwargs: dict | None = None, environment_kwargs: dict | 
       ValueError: unknown name or argument, or a value out of range; the message lists what is valid.
     """
     return base.make_environment(make_task(name, task_kwargs), environment_kwargs)
+
+
+def difficulty_arguments(parser: argparse.ArgumentParser) -> None:
+    """Adds the command-line flags that choose a scenario (default: labyrinth) and its difficulty."""
+    parser.add_argument("--scenario", default=None, choices=ALL_TASKS, help="default: labyrinth")
+    parser.add_argument("--size", type=int, default=None, help="maze size n (Labyrinth, Find-and-return, K-item)")
+    parser.add_argument("--num-items", type=int, default=None, help="K (Ordered K-item)")
+    parser.add_argument("--complexity", type=int, default=None, help="c (Two-colour)")
+
+
+def difficulty_kwargs(args: argparse.Namespace) -> dict:
+    """The task arguments of the flags added by :func:`difficulty_arguments` that were given."""
+    return {
+        key: value for key, value in (("size", args.size), ("num_items", args.num_items), ("complexity", args.complexity))
+        if value is not None
+    }
 
 
 def _check_name(name: str) -> str:

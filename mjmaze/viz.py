@@ -23,7 +23,7 @@ try:
 except ImportError as error:  # pragma: no cover - depends on the install
     raise ImportError("mjmaze.viz needs Pillow: pip install 'mjmaze[viz]'") from error
 
-from mjmaze import configs, mjcf, render
+from mjmaze import configs, files, mjcf, render, suite
 from mjmaze.tasks import base
 
 PATH_COLOUR = (255, 255, 255)
@@ -109,10 +109,8 @@ class TopDown:
 
 
 def horizontal_fov(task: base.MazeTask) -> float:
-    """The ego camera's horizontal field of view in radians."""
-    fovy = math.radians(73.74)  # arena.xml's ego camera
-    width, height = task.observation_spec(None)["pixels"].shape[1::-1]
-    return 2 * math.atan(math.tan(fovy / 2) * width / height)
+    """The ego camera's horizontal field of view in radians (of a task whose env was reset)."""
+    return task.horizontal_fov
 
 
 def line_of_sight(config: configs.MazeConfig, start, end) -> bool:
@@ -196,35 +194,14 @@ def compose(ego: np.ndarray, top_down: np.ndarray, lines: Sequence[str] = (), sc
 
 def save_png(path: str | pathlib.Path, image: np.ndarray) -> pathlib.Path:
     """Writes ``image`` as a PNG through a temporary file and a rename (never half-written)."""
-    path = pathlib.Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp")
-    Image.fromarray(image).save(tmp, format="PNG")
-    tmp.replace(path)
-    return path
-
-
-def difficulty_arguments(parser: argparse.ArgumentParser) -> None:
-    """Adds the command-line flags that choose a scenario and its difficulty."""
-    parser.add_argument("--scenario", default=None, help="labyrinth (default), find_return, k_item or two_colour")
-    parser.add_argument("--size", type=int, default=None, help="maze size n (Labyrinth, Find-and-return, K-item)")
-    parser.add_argument("--num-items", type=int, default=None, help="K (Ordered K-item)")
-    parser.add_argument("--complexity", type=int, default=None, help="c (Two-colour)")
-
-
-def difficulty_kwargs(args: argparse.Namespace) -> dict:
-    """The task arguments of the flags added by :func:`difficulty_arguments` that were given."""
-    return {
-        key: value for key, value in (("size", args.size), ("num_items", args.num_items), ("complexity", args.complexity))
-        if value is not None
-    }
+    return files.atomic_write(pathlib.Path(path), lambda tmp: Image.fromarray(image).save(tmp, format="PNG"))
 
 
 def main(argv: list[str] | None = None) -> None:
     import mjmaze
 
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    difficulty_arguments(parser)
+    suite.difficulty_arguments(parser)
     parser.add_argument("--split", default="train", choices=configs.SPLITS)
     parser.add_argument("--config", type=int, default=0, help="configuration index in the split")
     parser.add_argument("--random-steps", type=int, default=0, help="draw the path of this many random steps")
@@ -234,7 +211,7 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     try:
         env = mjmaze.load(args.scenario or "labyrinth", task_kwargs={
-            "split": args.split, "first_config": args.config, "random": args.seed, **difficulty_kwargs(args),
+            "split": args.split, "first_config": args.config, "random": args.seed, **suite.difficulty_kwargs(args),
         })
     except ValueError as error:
         raise SystemExit(f"error: {error}") from None
@@ -252,7 +229,7 @@ def main(argv: list[str] | None = None) -> None:
     env.task.close()
     save_png(args.out, image)
     config = env.task.config
-    print(f"{args.scenario or 'labyrinth'} {difficulty_kwargs(args)} {args.split} configuration {config.index}: {args.out}")
+    print(f"{args.scenario or 'labyrinth'} {suite.difficulty_kwargs(args)} {args.split} configuration {config.index}: {args.out}")
 
 
 if __name__ == "__main__":

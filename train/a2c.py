@@ -30,7 +30,7 @@ import torch
 import tyro
 from torch.nn import functional as F
 
-from mjmaze import suite
+from mjmaze import files, suite
 from mjmaze.vector import MazeVectorEnv
 from train import checkpoint
 from train.model import Agent
@@ -182,7 +182,7 @@ def train(args: Args) -> pathlib.Path:
             agent.load_state_dict(state["model"])
             optimizer.load_state_dict(state["optimizer"])
             step, update = int(state["step"]), int(state["update"])
-        checkpoint.atomic_write_json(run_dir / "config.json", config)
+        files.atomic_write_json(run_dir / "config.json", config)
         return _loop(args, envs, agent, optimizer, device, run_dir, step, update)
     finally:
         envs.close()
@@ -294,7 +294,7 @@ def _trim_metrics(path: pathlib.Path, step: int) -> None:
                 kept.append(line + "\n")
         except (json.JSONDecodeError, KeyError, TypeError):  # a line cut by a kill
             continue
-    checkpoint.atomic_write_bytes(path, "".join(kept).encode())
+    files.atomic_write_bytes(path, "".join(kept).encode())
 
 
 def _raise_stop(signum, frame):

@@ -32,6 +32,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 import mjmaze
+from mjmaze import files
 from train import checkpoint, policy
 from train.a2c import PAPER_METRIC
 
@@ -54,7 +55,7 @@ def save_figure(figure: Figure, path: pathlib.Path) -> pathlib.Path:
     """Saves a matplotlib figure as a PNG, atomically."""
     buffer = io.BytesIO()
     figure.savefig(buffer, format="png", dpi=110, bbox_inches="tight")
-    checkpoint.atomic_write_bytes(path, buffer.getvalue())
+    files.atomic_write_bytes(path, buffer.getvalue())
     return path
 
 
@@ -136,7 +137,7 @@ def analyse(source_args: argparse.Namespace, episodes: int, out: pathlib.Path | 
     buffer = io.BytesIO()
     np.savez_compressed(buffer, hidden=hidden, episode=episode_of, step=steps, pose=poses,
                         landmark_first_seen=first_seen, **({"totem_green": totem_green} if totem_green is not None else {}))
-    checkpoint.atomic_write_bytes(out / "states.npz", buffer.getvalue())
+    files.atomic_write_bytes(out / "states.npz", buffer.getvalue())
     if heatmap_episode is None:  # the longest episode shows the most
         heatmap_episode = int(np.argmax([e.length for e in played]))
     if not 0 <= heatmap_episode < len(played):
@@ -149,7 +150,7 @@ def analyse(source_args: argparse.Namespace, episodes: int, out: pathlib.Path | 
     embedding = tsne(hidden[chosen], source_args.seed)
     buffer = io.BytesIO()
     np.savez_compressed(buffer, embedding=embedding, state_index=chosen)
-    checkpoint.atomic_write_bytes(out / "tsne.npz", buffer.getvalue())
+    files.atomic_write_bytes(out / "tsne.npz", buffer.getvalue())
     save_figure(tsne_figure(embedding, steps[chosen], episode_of[chosen], title,
                             None if totem_green is None else totem_green[chosen]), out / "tsne.png")
 
@@ -166,7 +167,7 @@ def analyse(source_args: argparse.Namespace, episodes: int, out: pathlib.Path | 
         ],
         "files": [str(out / name) for name in ("states.npz", "heatmap.png", "tsne.png", "tsne.npz", "summary.json")],
     }
-    checkpoint.atomic_write_json(out / "summary.json", summary)
+    files.atomic_write_json(out / "summary.json", summary)
     return summary
 
 

@@ -8,12 +8,11 @@ and is left exactly as it was.
 
 from __future__ import annotations
 
-import json
-import os
 import pathlib
-import tempfile
 
 import torch
+
+from mjmaze.files import atomic_write
 
 PREFIX, SUFFIX = "step_", ".pt"
 # What must agree between a checkpoint and the run that loads it.
@@ -24,33 +23,6 @@ class CheckpointError(RuntimeError):
     """A checkpoint that cannot be used; the file is left untouched."""
 
 
-def _readable(tmp: str) -> None:
-    """mkstemp makes owner-only files; give the result the usual permissions."""
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp, 0o666 & ~umask)
-
-
-def atomic_write_bytes(path: pathlib.Path, data: bytes) -> None:
-    """Writes ``data`` to ``path`` through a temporary file and a rename."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-            f.flush()
-            os.fsync(f.fileno())
-        _readable(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        pathlib.Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def atomic_write_json(path: pathlib.Path, value) -> None:
-    atomic_write_bytes(path, (json.dumps(value, indent=2, sort_keys=True) + "\n").encode())
-
-
 def checkpoints(directory: pathlib.Path) -> list[pathlib.Path]:
     """Checkpoint files in ``directory``, oldest first."""
     return sorted(directory.glob(f"{PREFIX}*{SUFFIX}"))
@@ -58,17 +30,7 @@ def checkpoints(directory: pathlib.Path) -> list[pathlib.Path]:
 
 def save(directory: pathlib.Path, state: dict, step: int, keep: int) -> pathlib.Path:
     """Saves ``state`` as the checkpoint of ``step`` and keeps the ``keep`` newest."""
-    directory.mkdir(parents=True, exist_ok=True)
-    path = directory / f"{PREFIX}{step:012d}{SUFFIX}"
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
-    os.close(fd)
-    try:
-        torch.save(state, tmp)
-        _readable(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        pathlib.Path(tmp).unlink(missing_ok=True)
-        raise
+    path = atomic_write(directory / f"{PREFIX}{step:012d}{SUFFIX}", lambda tmp: torch.save(state, tmp))
     for old in checkpoints(directory)[:-keep]:
         old.unlink()
     return path

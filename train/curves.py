@@ -21,7 +21,8 @@ import pathlib
 import numpy as np
 from matplotlib.figure import Figure
 
-from train import checkpoint
+from mjmaze import files
+from train import checkpoint, evaluate
 from train.a2c import PAPER_METRIC
 from train.analysis import save_figure
 
@@ -57,8 +58,6 @@ def read_run(run_dir: pathlib.Path) -> dict:
 
 def evaluate_checkpoints(run_dir: pathlib.Path, num_envs: int = 16) -> None:
     """Greedy evaluation of each kept checkpoint not evaluated yet (cached in ``evals/``)."""
-    from train import evaluate
-
     for path in checkpoint.checkpoints(run_dir / "checkpoints"):
         out = run_dir / "evals" / path.with_suffix(".json").name
         if not out.exists():
@@ -170,7 +169,7 @@ def figure(groups: list[dict], title: str = "") -> Figure:
 def write(groups: list[dict], out: pathlib.Path, title: str = "") -> pathlib.Path:
     """Writes the PNG and its ``.json`` numbers."""
     save_figure(figure(groups, title), out)
-    checkpoint.atomic_write_json(out.with_suffix(".json"), groups)
+    files.atomic_write_json(out.with_suffix(".json"), groups)
     return out
 
 

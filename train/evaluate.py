@@ -18,6 +18,7 @@ import pathlib
 import numpy as np
 import torch
 
+from mjmaze import files
 from mjmaze.vector import MazeVectorEnv
 from train import checkpoint, policy
 from train.a2c import PAPER_METRIC, Args, pick_device
@@ -91,7 +92,7 @@ def evaluate(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | 
     }
     for split in ("train", "test"):
         result[split] = play_split(agent, args, split, num_envs, torch_device, num_configs=num_configs)
-    checkpoint.atomic_write_json(pathlib.Path(out) if out else pathlib.Path(run_dir) / "eval.json", result)
+    files.atomic_write_json(pathlib.Path(out) if out else pathlib.Path(run_dir) / "eval.json", result)
     return result
 
 

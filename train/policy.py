@@ -170,7 +170,7 @@ def policy_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("source", help=f"a run folder (runs/<name>) or '{RANDOM}' (an untrained agent acting uniformly)")
     parser.add_argument("--checkpoint", type=pathlib.Path, default=None, help="default: the run's latest")
     parser.add_argument("--sample", action="store_true", help="sample actions instead of the greedy argmax")
-    viz.difficulty_arguments(parser)
+    suite.difficulty_arguments(parser)
     parser.add_argument("--split", default="test", choices=("train", "test"))
     parser.add_argument("--seed", type=int, default=0)
 
@@ -180,7 +180,7 @@ def policy_from_arguments(args: argparse.Namespace) -> tuple[str, dict, Policy, 
 
     A run decides the scenario and difficulty (flags saying otherwise are an error).
     """
-    flags = viz.difficulty_kwargs(args)
+    flags = suite.difficulty_kwargs(args)
     if args.source == RANDOM:
         scenario = args.scenario or "labyrinth"
         task_kwargs = Args(scenario=scenario, **flags).task_kwargs()  # checks the scenario and flags

@@ -21,7 +21,7 @@ import imageio.v2 as imageio
 import numpy as np
 
 import mjmaze
-from mjmaze import viz
+from mjmaze import files, viz
 from train import checkpoint, policy
 from train.a2c import PAPER_METRIC
 
@@ -106,7 +106,7 @@ def record(source_args: argparse.Namespace, episodes: int, out: pathlib.Path, fp
     finally:
         top_down.close()
         env.task.close()
-    checkpoint.atomic_write_json(path.with_suffix(".json"), summary)
+    files.atomic_write_json(path.with_suffix(".json"), summary)
     return summary
 
 

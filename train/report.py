@@ -27,7 +27,8 @@ import pathlib
 
 import numpy as np
 
-from train import checkpoint, curves
+from mjmaze import files
+from train import curves
 from train.a2c import PAPER_METRIC
 from train.sweep import DIFFICULTY
 
@@ -126,17 +127,17 @@ def report(sweep_dir: pathlib.Path, out: pathlib.Path | None = None) -> dict:
     out = out or sweep_dir
     rows, run_dirs = collect(sweep_dir)
     text = markdown(rows, sweep_dir)
-    checkpoint.atomic_write_bytes(out / "report.md", text.encode())
+    files.atomic_write_bytes(out / "report.md", text.encode())
     buffer = io.StringIO()
     writer = csv.DictWriter(buffer, fieldnames=CSV_FIELDS)
     writer.writeheader()
     writer.writerows(rows)
-    checkpoint.atomic_write_bytes(out / "report.csv", buffer.getvalue().encode())
-    files = [out / "report.md", out / "report.csv"]
+    files.atomic_write_bytes(out / "report.csv", buffer.getvalue().encode())
+    written = [out / "report.md", out / "report.csv"]
     for scenario in dict.fromkeys(r["scenario"] for r in rows):
         dirs = [d for d in run_dirs if json.loads((d / "config.json").read_text())["scenario"] == scenario]
-        files.append(curves.write(curves.curves(dirs), out / f"curves_{scenario}.png", title=str(sweep_dir)))
-    return {"rows": rows, "markdown": text, "files": [str(f) for f in files]}
+        written.append(curves.write(curves.curves(dirs), out / f"curves_{scenario}.png", title=str(sweep_dir)))
+    return {"rows": rows, "markdown": text, "files": [str(f) for f in written]}
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -30,7 +30,7 @@ import pathlib
 import sys
 import time
 
-from mjmaze import suite
+from mjmaze import files, suite
 from train import a2c, checkpoint, evaluate
 
 # The task argument that sets each scenario's difficulty in the paper's Table 2.
@@ -204,7 +204,7 @@ def main(argv: list[str] | None = None) -> None:
     except ValueError as error:
         raise SystemExit(f"error: {error}") from None
     sweep_dir = args.sweeps_dir / (args.name or args.grid)
-    checkpoint.atomic_write_json(sweep_dir / "sweep.json", {
+    files.atomic_write_json(sweep_dir / "sweep.json", {
         "grid": args.grid, "runs": [s.name for s in specs], "settings": settings, "command": sys.argv,
         "eval_configs": args.eval_configs,
     })

@@ -124,6 +124,8 @@ class MazeTask(base.Task):
         #: (e.g. a slot of a vector env's shared memory) = rendered into it.
         self.observation_buffer: np.ndarray | None = None
         self._renderer: render.EgoRenderer | None = None
+        #: The ego camera's horizontal field of view in radians (known once the task has a physics).
+        self.horizontal_fov = math.nan
         self._walls: mjcf.WallLayout | None = None
         self._bound_data = None
         self.config: configs.MazeConfig | None = None
@@ -151,6 +153,8 @@ class MazeTask(base.Task):
         self._qpos, self._qvel = data.qpos, data.qvel
         self._walls = mjcf.WallLayout(model, self.layout.grid_size, self.layout.cell_size)
         self._renderer = render.EgoRenderer(model, CAMERA, self._width, self._height)
+        fovy = math.radians(model.cam(CAMERA).fovy[0])
+        self.horizontal_fov = 2 * math.atan(math.tan(fovy / 2) * self._width / self._height)
         self._config_in_model = None
         self._speed = FORWARD_PER_STEP / (TICS_PER_STEP * model.opt.timestep)
         self._turn_rate = TURN_PER_STEP / (TICS_PER_STEP * model.opt.timestep)
