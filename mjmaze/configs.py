@@ -4,10 +4,18 @@ A configuration (wall layout, spawn cell, object cells) is a pure function of
 ``(scenario, difficulty, split, index)``: its seed is derived with
 ``numpy.random.SeedSequence`` from those integers alone, so it is the same on
 every machine and Python version. Train and test draw from disjoint streams
-(the split is part of the seed) and, on top of that, every wall layout belongs
-to exactly one split by a hash of its walls: a layout that hashes to the other
-split is redrawn. So no test layout can equal a training layout, whatever the
-set sizes.
+(the split is part of the seed) of **one** distribution, and every whole
+configuration (walls + spawn + objects) belongs to exactly one split by a hash
+of it: a draw that hashes to the other split is redrawn. So no test
+configuration can equal a training one, whatever the set sizes.
+
+Why the whole configuration and not the walls alone: where the layout space is
+tiny (Two-colour at complexity 0 has one wall layout, at complexity 1 about 18%
+of draws are the empty maze) a split by walls puts every draw of a frequent
+layout in one split, and train and test become different distributions. Each
+layout has many spawn/object placements, about half of which hash to each
+split, so hashing whole configurations keeps both splits draws of the same
+distribution.
 """
 
 from __future__ import annotations
@@ -74,6 +82,10 @@ class MazeConfig:
         """Bytes that identify the wall layout (equal keys = equal layouts)."""
         return layout_key(self.h_walls, self.v_walls)
 
+    def config_key(self) -> bytes:
+        """Bytes that identify the whole configuration (walls, spawn cell, object cells)."""
+        return config_key(self.h_walls, self.v_walls, [self.spawn_cell, *self.object_cells])
+
     def __repr__(self) -> str:
         return (
             f"MazeConfig({self.scenario!r}, difficulty={self.difficulty}, split={self.split!r}, "
@@ -86,10 +98,19 @@ def layout_key(h_walls: np.ndarray, v_walls: np.ndarray) -> bytes:
     return size.to_bytes(2, "little") + np.packbits(h_walls).tobytes() + np.packbits(v_walls).tobytes()
 
 
-def layout_split(h_walls: np.ndarray, v_walls: np.ndarray) -> str:
-    """The split a wall layout belongs to, from a hash of its walls."""
-    digest = hashlib.sha256(layout_key(h_walls, v_walls)).digest()
-    return SPLITS[digest[0] & 1]
+def config_key(h_walls: np.ndarray, v_walls: np.ndarray, cells: Sequence[tuple[int, int]]) -> bytes:
+    """Bytes that identify a whole configuration: walls, then the spawn and object cells."""
+    return layout_key(h_walls, v_walls) + np.asarray(cells, dtype=np.uint8).tobytes()
+
+
+def config_split(key: bytes) -> str:
+    """The split a configuration belongs to, from a hash of its :func:`config_key`."""
+    return SPLITS[hashlib.sha256(key).digest()[0] & 1]
+
+
+# Draws per configuration before giving up: each draw lands in the wanted split
+# with probability about 1/2, so 200 misses in a row mean that split is empty.
+_MAX_DRAWS = 200
 
 
 @functools.lru_cache(maxsize=8192)
@@ -105,23 +126,24 @@ def generate_config(scenario: str, difficulty: int, split: str, index: int, spec
         [_ROOT_ENTROPY, _SCENARIO_CODES[scenario], int(difficulty), _SPLIT_CODES[split], int(index)]
     )
     rng = np.random.default_rng(seed)
-    while True:  # redraw layouts that belong to the other split (about half)
-        h_walls, v_walls = maze.generate_walls(spec.grid_size, spec.keep_probability, rng)
-        if layout_split(h_walls, v_walls) == split:
+    n = spec.grid_size
+    fixed = [(n // 2, n // 2)] if spec.centre_object else []
+    free = [(row, col) for row in range(n) for col in range(n) if (row, col) not in fixed]
+    if 1 + spec.num_objects - len(fixed) > len(free):
+        raise ValueError(f"a {n}x{n} grid has too few cells for a spawn and {spec.num_objects} object(s)")
+    for _ in range(_MAX_DRAWS):  # redraw configurations that belong to the other split (about half)
+        h_walls, v_walls = maze.generate_walls(n, spec.keep_probability, rng)
+        drawn = rng.choice(len(free), size=1 + spec.num_objects - len(fixed), replace=False)
+        spawn, others = free[drawn[0]], [free[k] for k in drawn[1:]]
+        if config_split(config_key(h_walls, v_walls, [spawn, *fixed, *others])) == split:
             break
+    else:
+        raise ValueError(
+            f"no {split} configuration found for {scenario} at difficulty {difficulty} after {_MAX_DRAWS} draws: "
+            "this setting has too few distinct configurations to split; use the other split or a higher difficulty"
+        )
     h_walls.flags.writeable = False
     v_walls.flags.writeable = False
-
-    n = spec.grid_size
-    free = np.arange(n * n)
-    fixed: list[int] = []
-    if spec.centre_object:
-        centre = (n // 2) * n + n // 2
-        fixed.append(centre)
-        free = free[free != centre]
-    drawn = rng.choice(free, size=1 + spec.num_objects - len(fixed), replace=False)
-    spawn, others = int(drawn[0]), [int(c) for c in drawn[1:]]
-    to_cell = lambda flat: (flat // n, flat % n)  # noqa: E731
     return MazeConfig(
         scenario=scenario,
         difficulty=int(difficulty),
@@ -130,8 +152,8 @@ def generate_config(scenario: str, difficulty: int, split: str, index: int, spec
         cell_size=spec.cell_size,
         h_walls=h_walls,
         v_walls=v_walls,
-        spawn_cell=to_cell(spawn),
-        object_cells=tuple(to_cell(c) for c in fixed + others),
+        spawn_cell=spawn,
+        object_cells=tuple(fixed + others),
     )
 
 

@@ -57,11 +57,13 @@ def from_paper_json(path: str | os.PathLike, scenario: str, index: int = 0, spli
     if not isinstance(data, dict):
         raise LayoutError(f"{path}: expected a JSON object at the top level")
 
-    def points(field: str, value, width: int) -> np.ndarray:
+    def points(field: str, value, width: int, allow_empty: bool = False) -> np.ndarray:
         try:
             array = np.array(value, dtype=float)
         except (TypeError, ValueError) as error:
             raise fail(field, f"expected numbers ({error})") from error
+        if allow_empty and isinstance(value, list) and not value:
+            return array.reshape(0, width)
         if array.ndim != 2 or array.shape[1] != width or not np.isfinite(array).all():
             raise fail(field, f"expected a list of {width} numbers per entry, got {value!r:.80}")
         return array / DOOM_UNITS_PER_METRE
@@ -88,7 +90,9 @@ def from_paper_json(path: str | os.PathLike, scenario: str, index: int = 0, spli
     v_walls = np.zeros((size, size + 1), dtype=bool)
     h_walls[[0, -1]] = True
     v_walls[:, [0, -1]] = True
-    for x1, y1, x2, y2 in (points("walls", field("walls"), 4) - np.tile(low, 2)) / cell:
+    # An empty list is a maze with no interior walls (57 of the released
+    # Two-colour complexity-1 files).
+    for x1, y1, x2, y2 in (points("walls", field("walls"), 4, allow_empty=True) - np.tile(low, 2)) / cell:
         if abs(y1 - y2) < _GRID_TOLERANCE:  # horizontal
             line, start, stop = grid(y1, "walls"), grid(min(x1, x2), "walls"), grid(max(x1, x2), "walls")
             h_walls[line, start:stop] = True
@@ -123,7 +127,10 @@ def from_paper_json(path: str | os.PathLike, scenario: str, index: int = 0, spli
         spawn = cell_of("start", field("start"))
         objects = (cell_of("end", field("end")),)
         difficulty = size
-    if spawn in objects:
+    # The released Two-colour generator could spawn the agent in the totem's
+    # cell (35 of its files do): a scenario that plays such files as released
+    # says so; elsewhere a shared cell is a broken file.
+    if spawn in objects and not getattr(module, "IMPORTED_SPAWN_MAY_SHARE_A_CELL", False):
         raise fail("start" if scenario != "k_item" else "spawn", "the spawn shares a cell with an object")
     h_walls.flags.writeable = False
     v_walls.flags.writeable = False

@@ -8,7 +8,8 @@ import sys
 import numpy as np
 import pytest
 
-from mjmaze import configs, maze
+import mjmaze
+from mjmaze import configs, maze, suite
 from mjmaze.tasks import labyrinth
 
 SPEC9 = configs.LayoutSpec(9, 1.0, 0.6, num_objects=1)
@@ -75,25 +76,78 @@ def test_frozen_reference_configuration():
     assert _digest(config) == REFERENCE_DIGEST, maze.to_ascii(config.h_walls, config.v_walls)
 
 
-REFERENCE_DIGEST = "5919d54dc1e8d4897daf5e26a33df73ef2362657beb7001d609b75c9af826489"
+REFERENCE_DIGEST = "93b48dcd91c84b0aa01b162df6270c5d43b4360e1dd515bba00dc9ef144a91c4"
 
 
 @pytest.mark.parametrize("size", labyrinth.SIZES)
-def test_train_and_test_layouts_are_disjoint(size):
+def test_train_and_test_configurations_are_disjoint(size):
     train = configs.ConfigSet("labyrinth", size, "train", spec(size))
     test = configs.ConfigSet("labyrinth", size, "test", spec(size))
     assert (len(train), len(test)) == (256, 64)
-    train_keys = {c.layout_key() for c in train}
-    assert not train_keys & {c.layout_key() for c in test}
+    assert not {c.config_key() for c in train} & {c.config_key() for c in test}
 
 
 def test_disjoint_for_large_training_sets_too():
     # The paper's generalisation study goes up to 1024 training mazes; 5x5 is the tightest.
     small = configs.LayoutSpec(5, 1.0, 0.6, 1)
-    train = {c.layout_key() for c in configs.ConfigSet("labyrinth", 5, "train", small, num_configs=1024)}
-    test = {c.layout_key() for c in configs.ConfigSet("labyrinth", 5, "test", small, num_configs=256)}
-    assert not train & test
-    assert all(configs.layout_split(c.h_walls, c.v_walls) == "test" for c in configs.ConfigSet("labyrinth", 5, "test", small))
+    train = {c.config_key() for c in configs.ConfigSet("labyrinth", 5, "train", small, num_configs=1024)}
+    test = configs.ConfigSet("labyrinth", 5, "test", small, num_configs=256)
+    assert not train & {c.config_key() for c in test}
+    assert all(configs.config_split(c.config_key()) == "test" for c in test)
+
+
+PAPER_SETTINGS = (
+    [("labyrinth", {"size": n}) for n in (5, 7, 9, 11, 13)]
+    + [("find_return", {"size": n}) for n in (5, 7, 9, 11, 13)]
+    + [("k_item", {"num_items": k}) for k in (2, 4, 6, 8)]
+    + [("two_colour", {"complexity": c}) for c in (1, 3, 5, 7)]
+)
+
+
+def interior_walls(config):
+    return int(config.h_walls[1:-1].sum() + config.v_walls[:, 1:-1].sum())
+
+
+@pytest.mark.parametrize("scenario, kwargs", PAPER_SETTINGS, ids=lambda v: str(v))
+def test_train_and_test_are_draws_of_one_distribution(scenario, kwargs):
+    from scipy.stats import ks_2samp
+
+    task = suite.make_task(scenario, kwargs)
+    counts = {
+        split: [interior_walls(c) for c in configs.ConfigSet(task.scenario, task.configs.difficulty, split, task.layout, 1024)]
+        for split in configs.SPLITS
+    }
+    assert ks_2samp(counts["train"], counts["test"]).pvalue > 0.01
+
+
+def test_two_colour_splits_hold_the_empty_maze_alike():
+    # Complexity 1: about 18% of draws are the empty maze; a split by walls put all of them in train.
+    task = suite.make_task("two_colour", {"complexity": 1})
+    for split in configs.SPLITS:
+        empty = np.mean([interior_walls(c) == 0 for c in configs.ConfigSet("two_colour", 1, split, task.layout, 1024)])
+        assert 0.13 < empty < 0.23, (split, empty)
+
+
+def test_complexity_zero_builds_both_splits():
+    # One wall layout (the empty maze): the 24 spawn cells are the configurations, shared out by hash.
+    keys = {}
+    for split in configs.SPLITS:
+        env = mjmaze.load("two_colour", task_kwargs={"complexity": 0, "split": split})
+        env.reset()
+        assert interior_walls(env.task.config) == 0
+        keys[split] = {c.config_key() for c in env.task.configs}
+        assert len(keys[split]) > 1
+    assert not keys["train"] & keys["test"]
+
+
+def test_a_split_with_no_configuration_is_one_clear_error(monkeypatch):
+    monkeypatch.setattr(configs, "config_split", lambda key: "train")
+    configs.generate_config.cache_clear()
+    try:
+        with pytest.raises(ValueError, match="no test configuration"):
+            configs.generate_config("two_colour", 0, "test", 0, configs.LayoutSpec(5, 2.0, 0.0, 1, centre_object=True))
+    finally:
+        configs.generate_config.cache_clear()
 
 
 def test_spawn_and_objects_are_distinct_cells_inside_the_grid():

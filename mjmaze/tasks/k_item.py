@@ -81,10 +81,10 @@ class KItem(base.MazeTask):
         physics.show_objects(self._geom_ids, True)
         self._next = 0
 
-    def scenario_step(self, physics: base.MazePhysics, x: float, y: float) -> tuple[float, bool]:
-        # Items left are kinds next..K-1; at most one is in reach (cells are 1.25 m apart).
-        remaining = self._items_xy[self._next :]
-        near = np.flatnonzero(((remaining - (x, y)) ** 2).sum(axis=1) < base.PICKUP_RADIUS**2)
+    def scenario_step(self, physics: base.MazePhysics, path) -> tuple[float, bool]:
+        # Items left are kinds next..K-1, in cells 1.25 m apart: one step (0.25 m)
+        # reaches at most one of them, at any of its tics.
+        near = np.flatnonzero(base.reached(self._items_xy[self._next :], path) >= 0)
         if not len(near):
             return STEP_REWARD, False
         if near[0] != 0:  # not the next in order

@@ -51,8 +51,8 @@ class Labyrinth(base.MazeTask):
         physics.show_objects(geom_ids, True)
         self._success = False
 
-    def scenario_step(self, physics: base.MazePhysics, x: float, y: float) -> tuple[float, bool]:
-        if base.within_pickup(self._exit_xy, x, y):
+    def scenario_step(self, physics: base.MazePhysics, path) -> tuple[float, bool]:
+        if base.reached(self._exit_xy, path)[0] >= 0:
             self._success = True
             return STEP_REWARD + EXIT_REWARD, True
         return STEP_REWARD, False

@@ -6,7 +6,8 @@ Observation
     ``pixels``: uint8 RGB ``(64, 112, 3)``.
 Rules
     A tall totem at the maze centre is red or green, 50/50 per episode. 10 green
-    and 10 red items start at random free positions; one more appears every 30
+    and 10 red items start at random positions, uniform over the floor the agent
+    can stand on (as released) and out of its reach; one more appears every 30
     tics, colours alternating, with no cap (as released; at most 90 in an
     episode, a fixed pool of 90 geoms). Health starts at 100 (cap 100): an item
     of the totem's colour gives +25, the other colour takes 25, and health decays
@@ -22,7 +23,10 @@ Arguments
     ``complexity`` c in 0..10 (paper: 1, 3, 5, 7; each interior wall is kept with
     probability c/10), ``correct_item_reward``, ``item_cap`` (None = no cap, as
     released) and the common task arguments. The spawn heading is fixed at 0
-    (facing +x), as released; the spawn cell is never the totem's.
+    (facing +x), as released. Generated mazes never spawn the agent in the
+    totem's cell; the released generator could, and such an imported layout
+    plays as released: the agent starts inside the totem, which does not block
+    it until it has stepped clear (as ZDoom lets overlapping actors move apart).
 Metric
     ``duration``: tics survived (max 2100); also ``health`` and ``totem_green``.
 """
@@ -49,13 +53,19 @@ ITEM_HEALTH = 25
 HEALTH_DECAY_PER_STEP = 1
 SURVIVAL_REWARD = 0.01 * base.TICS_PER_STEP
 CORRECT_ITEM_REWARD = 1.0
-# Items are drawn inside a cell, this far from its walls, and this far from the totem.
-ITEM_WALL_CLEARANCE = 0.25
-ITEM_TOTEM_CLEARANCE = 0.4
+# Items appear uniformly where the agent can stand: at least its radius from
+# every wall, clear of the totem by both radii, and out of the agent's reach.
+ITEM_WALL_CLEARANCE = base.AGENT_RADIUS
+# Draws per item before giving up (a draw lands on free floor far more often than 1 in 10).
+_MAX_ITEM_DRAWS = 10_000
+# Imported layouts may spawn the agent in the totem's cell (see TwoColour).
+IMPORTED_SPAWN_MAY_SHARE_A_CELL = True
 
 RED, GREEN = (0.9, 0.1, 0.1, 1.0), (0.1, 0.8, 0.1, 1.0)
 TOTEM_RADIUS, TOTEM_HEIGHT = 0.125, 1.0
 TOTEM = mjcf.ObjectGeom("totem", "cylinder", (TOTEM_RADIUS, TOTEM_HEIGHT / 2), RED, TOTEM_HEIGHT / 2, collides=True)
+# The agent's centre never comes closer to the totem's than this.
+TOTEM_CLEARANCE = TOTEM_RADIUS + base.AGENT_RADIUS
 ITEM_HALF = 0.09
 ITEMS = tuple(
     mjcf.ObjectGeom(f"item_{k}", "box", (ITEM_HALF, ITEM_HALF, ITEM_HALF), RED, ITEM_HALF) for k in range(POOL_SIZE)
@@ -99,19 +109,26 @@ class TwoColour(base.MazeTask):
         mocap_ids, geom_ids = physics.object_ids([TOTEM.name] + [item.name for item in ITEMS])
         self._totem_mocap, self._totem_geom = mocap_ids[0], geom_ids[0]
         self._item_mocap, self._item_geoms = mocap_ids[1:], geom_ids[1:]
-        self._totem_xy = config.cell_centre(config.object_cells[0])
+        self._totem_xy = np.array(config.cell_centre(config.object_cells[0]))
+        self._wall_boxes = mjcf.wall_runs(config.h_walls, config.v_walls, config.cell_size)
+        self._half_extent = config.size * config.cell_size / 2
         self.totem_green = bool(self.random.rand() < 0.5)
         physics.place_objects(self._totem_mocap, self._totem_xy)
         physics.set_object_rgba(self._totem_geom, GREEN if self.totem_green else RED)
         physics.show_objects(self._totem_geom, True)
+        x, y, _ = physics.agent_pose()
+        self._inside_totem = self._distance_to_totem(x, y) < TOTEM_CLEARANCE
+        physics.set_object_collisions(self._totem_geom, not self._inside_totem)
         for geom, green in zip(self._item_geoms, self.item_green):
             physics.set_object_rgba(geom, GREEN if green else RED)
         physics.show_objects(self._item_geoms, False)
         self.item_active[:] = False
         self.items_spawned = 0
         self.health = START_HEALTH
-        x, y, _ = physics.agent_pose()
         self._spawn_items_due(0, x, y)
+
+    def _distance_to_totem(self, x: float, y: float) -> float:
+        return math.hypot(x - self._totem_xy[0], y - self._totem_xy[1])
 
     def _spawn_items_due(self, tics: int, x: float, y: float) -> None:
         due = min(2 * START_ITEMS_PER_COLOUR + tics // SPAWN_EVERY_TICS, self._item_cap)
@@ -124,20 +141,26 @@ class TwoColour(base.MazeTask):
             self.items_spawned += 1
 
     def _free_position(self, x: float, y: float) -> tuple[float, float]:
-        """A random point inside a random cell, clear of walls and the totem, out of the agent's reach."""
-        n, reach = self._config.size, ITEM_WALL_CLEARANCE
-        while True:
-            cx, cy = self._config.cell_centre((self.random.randint(n), self.random.randint(n)))
-            px = cx + self.random.uniform(-CELL_SIZE / 2 + reach, CELL_SIZE / 2 - reach)
-            py = cy + self.random.uniform(-CELL_SIZE / 2 + reach, CELL_SIZE / 2 - reach)
-            clear_of_totem = math.hypot(px - self._totem_xy[0], py - self._totem_xy[1]) > ITEM_TOTEM_CLEARANCE
-            if clear_of_totem and not base.within_pickup((px, py), x, y):
+        """A point drawn uniformly over the floor the agent can stand on, out of its reach."""
+        half = self._half_extent
+        wall_x, wall_y, wall_hx, wall_hy = self._wall_boxes.T
+        for _ in range(_MAX_ITEM_DRAWS):
+            px, py = self.random.uniform(-half, half, size=2)
+            # Distance from the point to each wall box (0 inside one).
+            gap_x = np.maximum(np.abs(px - wall_x) - wall_hx, 0.0)
+            gap_y = np.maximum(np.abs(py - wall_y) - wall_hy, 0.0)
+            clear_of_walls = (gap_x * gap_x + gap_y * gap_y).min() >= ITEM_WALL_CLEARANCE**2
+            clear_of_totem = self._distance_to_totem(px, py) >= TOTEM_CLEARANCE
+            if clear_of_walls and clear_of_totem and not base.within_pickup((px, py), x, y):
                 return px, py
+        raise RuntimeError(f"no free floor for an item after {_MAX_ITEM_DRAWS} draws in {self._config!r}")
 
-    def scenario_step(self, physics: base.MazePhysics, x: float, y: float) -> tuple[float, bool]:
+    def scenario_step(self, physics: base.MazePhysics, path) -> tuple[float, bool]:
         reward = 0.0
-        near = self.item_active & (((self.item_xy - (x, y)) ** 2).sum(axis=1) < base.PICKUP_RADIUS**2)
-        for k in np.flatnonzero(near):
+        active = np.flatnonzero(self.item_active)
+        tics = base.reached(self.item_xy[active], path)
+        # Items in the order the agent reached them (Doom tests every tic).
+        for k in active[tics >= 0][np.argsort(tics[tics >= 0], kind="stable")]:
             self.item_active[k] = False
             physics.show_objects(self._item_geoms[k], False)
             if self.item_green[k] == self.totem_green:
@@ -149,6 +172,10 @@ class TwoColour(base.MazeTask):
         self.health -= HEALTH_DECAY_PER_STEP
         if self.health <= 0:
             return reward, True
+        x, y = path[-1]
+        if self._inside_totem and self._distance_to_totem(x, y) >= TOTEM_CLEARANCE:
+            self._inside_totem = False  # stepped clear: the totem blocks from now on
+            physics.set_object_collisions(self._totem_geom, True)
         self._spawn_items_due(self.steps * base.TICS_PER_STEP, x, y)
         return reward + SURVIVAL_REWARD, False
 
