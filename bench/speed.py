@@ -1,13 +1,14 @@
-"""Single-process speed of one Labyrinth env: full step vs the raw render path.
+"""Single-process speed of one Labyrinth env: full step vs the raw render path, per visual style.
 
     python bench/speed.py [--size 9] [--steps 3000] [--rounds 5]
 
-Prints obs/s for, alternating in rounds so machine drift hits every side:
+Prints obs/s for, alternating in rounds so machine drift hits every side, each
+in the default "textured" frames and in the "flat" ones:
   render      mjv_updateScene + mjr_render + mjr_readPixels alone (the agent moving)
-  raw         the lean loop: 4 x mj_step + the render path (PERFORMANCE.md's "lean path")
+  raw         the lean loop: mj_step(model, data, 4) + the render path
   dm_control  env.step(action) of mjmaze.load("labyrinth"): action -> physics -> rules -> observation copy
   gymnasium   env.step(action) of gymnasium.make("mjmaze/Labyrinth-v0") (through its default wrappers)
-and the ratios full step / raw, plus a per-phase split of the full step.
+and the ratios full step / raw, textured / flat, plus a per-phase split of the full step.
 """
 
 from __future__ import annotations
@@ -21,18 +22,18 @@ import mujoco
 import numpy as np
 
 import mjmaze
-from mjmaze import render
+from mjmaze import mjcf, render
 
 
-def _lean_setup(size: int):
-    env = mjmaze.load("labyrinth", task_kwargs={"size": size, "random": 0})
+def _lean_setup(size: int, style: str):
+    env = mjmaze.load("labyrinth", task_kwargs={"size": size, "random": 0, "visual_style": style})
     env.reset()
     model, data = env.physics.model.ptr, env.physics.data.ptr
     return env, model, data, env.task._renderer
 
 
-def bench_render(size: int, steps: int) -> float:
-    env, model, data, renderer = _lean_setup(size)
+def bench_render(size: int, steps: int, style: str) -> float:
+    env, model, data, renderer = _lean_setup(size, style)
     rng = np.random.default_rng(0)
     yaws = rng.uniform(-np.pi, np.pi, steps)
     start = time.perf_counter()
@@ -45,8 +46,8 @@ def bench_render(size: int, steps: int) -> float:
     return rate
 
 
-def bench_raw(size: int, steps: int) -> float:
-    env, model, data, renderer = _lean_setup(size)
+def bench_raw(size: int, steps: int, style: str) -> float:
+    env, model, data, renderer = _lean_setup(size, style)
     rng = np.random.default_rng(0)
     velocities = rng.uniform(-2, 2, (steps, 3))
     start = time.perf_counter()
@@ -59,8 +60,8 @@ def bench_raw(size: int, steps: int) -> float:
     return rate
 
 
-def bench_dm_control(size: int, steps: int) -> float:
-    env = mjmaze.load("labyrinth", task_kwargs={"size": size, "random": 0})
+def bench_dm_control(size: int, steps: int, style: str) -> float:
+    env = mjmaze.load("labyrinth", task_kwargs={"size": size, "random": 0, "visual_style": style})
     actions = np.random.default_rng(0).integers(5, size=steps)
     env.reset()
     start = time.perf_counter()
@@ -72,8 +73,8 @@ def bench_dm_control(size: int, steps: int) -> float:
     return rate
 
 
-def bench_gymnasium(size: int, steps: int) -> float:
-    env = gymnasium.make("mjmaze/Labyrinth-v0", size=size)
+def bench_gymnasium(size: int, steps: int, style: str) -> float:
+    env = gymnasium.make("mjmaze/Labyrinth-v0", size=size, visual_style=style)
     actions = np.random.default_rng(0).integers(5, size=steps).tolist()
     env.reset(seed=0)
     start = time.perf_counter()
@@ -86,9 +87,9 @@ def bench_gymnasium(size: int, steps: int) -> float:
     return rate
 
 
-def phase_split(size: int, steps: int) -> dict[str, float]:
+def phase_split(size: int, steps: int, style: str) -> dict[str, float]:
     """Microseconds per agent step in each phase of the dm_control step."""
-    env = mjmaze.load("labyrinth", task_kwargs={"size": size, "random": 0})
+    env = mjmaze.load("labyrinth", task_kwargs={"size": size, "random": 0, "visual_style": style})
     env.reset()
     task, physics = env.task, env.physics
     actions = np.random.default_rng(0).integers(5, size=steps)
@@ -121,22 +122,29 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=5)
     args = parser.parse_args()
 
-    sides = {"render": bench_render, "raw": bench_raw, "dm_control": bench_dm_control, "gymnasium": bench_gymnasium}
-    rates: dict[str, list[float]] = {name: [] for name in sides}
-    for _ in range(args.rounds):
-        for name, bench in sides.items():
-            rates[name].append(bench(args.size, args.steps))
-    median = {name: statistics.median(values) for name, values in rates.items()}
+    benches = {"render": bench_render, "raw": bench_raw, "dm_control": bench_dm_control, "gymnasium": bench_gymnasium}
+    sides = [(name, style) for name in benches for style in mjcf.VISUAL_STYLES]
+    rates: dict[tuple[str, str], list[float]] = {side: [] for side in sides}
+    for round_ in range(args.rounds):
+        # Alternate the order of the styles too, so neither always runs first.
+        for name, style in sides if round_ % 2 == 0 else sides[::-1]:
+            rates[name, style].append(benches[name](args.size, args.steps, style))
+    median = {side: statistics.median(values) for side, values in rates.items()}
 
     print(f"Labyrinth {args.size}x{args.size}, one process, GL backend {render.gl_backend()}, "
           f"{args.rounds} rounds x {args.steps} steps (median, min-max)")
-    for name, values in rates.items():
-        print(f"  {name:<11} {median[name]:8.0f} obs/s   ({min(values):.0f}-{max(values):.0f})")
-    print(f"  ratio dm_control / raw : {median['dm_control'] / median['raw']:.2f}")
-    print(f"  ratio gymnasium / raw  : {median['gymnasium'] / median['raw']:.2f}")
-    print("  full step by phase (us per agent step):")
-    for key, value in phase_split(args.size, args.steps).items():
-        print(f"    {key:<34} {value:6.1f}")
+    for (name, style), values in rates.items():
+        print(f"  {name:<11} {style:<9} {median[name, style]:8.0f} obs/s   ({min(values):.0f}-{max(values):.0f})")
+    for style in mjcf.VISUAL_STYLES:
+        print(f"  {style:<9} ratio dm_control / raw : {median['dm_control', style] / median['raw', style]:.2f}, "
+              f"gymnasium / raw : {median['gymnasium', style] / median['raw', style]:.2f}")
+    for name in benches:
+        # Time per step, textured over flat (the fidelity budget: dm_control <= 1.25).
+        print(f"  step time textured / flat, {name:<11}: {median[name, 'flat'] / median[name, 'textured']:.2f}")
+    for style in mjcf.VISUAL_STYLES:
+        print(f"  full step by phase, {style} (us per agent step):")
+        for key, value in phase_split(args.size, args.steps, style).items():
+            print(f"    {key:<34} {value:6.1f}")
 
 
 if __name__ == "__main__":

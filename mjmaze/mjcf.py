@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 import importlib.resources
+import math
 import pathlib
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
@@ -19,15 +20,27 @@ from collections.abc import Sequence
 import mujoco
 import numpy as np
 
+#: ``visual_style`` values: "textured" (the default) gives walls and floor
+#: textures whose texels keep their size in the world and light that falls off
+#: with distance, the depth cues of the paper's ViZDoom frames; "flat" gives
+#: single-colour surfaces under a headlight, cheaper to render.
+VISUAL_STYLES = ("textured", "flat")
+TEXTURE_TEXELS = 64  # per side of a texture; one texture covers 1 m x 1 m
+# 1 / the mean grey of each texture (see _brick_texels, _tile_texels).
+_TEXTURE_GAIN = {"wall": 1.35, "floor": 1.55}
 WALL_THICKNESS = 0.125
 WALL_HEIGHT = 1.0
 WALL_MESH = "walls"
 OVERHEAD_CAMERA = "overhead"
 OVERHEAD_HEIGHT = 10.0
+LAMP = "lamp"
+EYE_HEIGHT = 0.32  # the ego camera's height (xml_templates/arena.xml)
 
-# Per wall box in the visual mesh: 8 corners, 4 side faces + the top (10
-# triangles; the bottom is never seen), one normal per visible face.
-_BOX_VERTS, _BOX_FACES, _BOX_NORMALS = 8, 10, 5
+# Per wall box in the visual mesh: 4 side faces + the top (the bottom is never
+# seen), each a quad of its own 4 vertices (texture coordinates differ per
+# face at a shared corner), 2 triangles and one normal.
+_BOX_QUADS = 5
+_BOX_VERTS, _BOX_FACES, _BOX_NORMALS = 4 * _BOX_QUADS, 2 * _BOX_QUADS, _BOX_QUADS
 _SIDE_CORNERS = ((0, 1), (1, 2), (2, 3), (3, 0))
 
 
@@ -81,22 +94,35 @@ def overhead_extent(grid_size: int, cell_size: float) -> float:
     return grid_size * cell_size + 2 * WALL_THICKNESS + 0.25
 
 
-def build_xml(grid_size: int, cell_size: float, objects: Sequence[ObjectGeom] = ()) -> str:
-    """The MJCF of an arena for ``grid_size x grid_size`` cells of ``cell_size`` metres."""
+def build_xml(
+    grid_size: int, cell_size: float, objects: Sequence[ObjectGeom] = (), visual_style: str = "textured"
+) -> str:
+    """The MJCF of an arena for ``grid_size x grid_size`` cells of ``cell_size`` metres.
+
+    A ``"textured"`` model needs :func:`paint_textures` after compiling.
+    """
+    if visual_style not in VISUAL_STYLES:
+        raise ValueError(f"visual_style must be one of {VISUAL_STYLES}, got {visual_style!r}")
     root = ET.fromstring(template_path().read_text())
     worldbody = root.find("worldbody")
     asset = root.find("asset")
+    if visual_style == "textured":
+        _add_textures(root)
     segments = wall_segments(grid_size, cell_size)
 
-    # A placeholder mesh with room for every segment (disjoint unit boxes, so the
-    # compiler merges no vertices); apply_walls overwrites it before first use.
-    capacity = len(segments)
+    # A placeholder mesh with room for the most quads any maze needs (every
+    # segment cut into pieces, all five quads each); WallLayout.apply overwrites
+    # it before first use. Its vertices are all distinct (disjoint boxes, the
+    # corners each quad shares nudged apart), so the compiler merges none.
+    capacity = len(segments) * _pieces_per_segment(cell_size)
     offsets = np.stack([np.arange(capacity) * 2.0, np.zeros(capacity)], axis=1)
-    verts, faces, _, _ = _box_mesh(np.hstack([offsets, np.full((capacity, 2), 0.5)]))
+    verts, faces, _, _, texcoords = _box_mesh(np.hstack([offsets, np.full((capacity, 2), 0.5)]))
+    verts += np.tile(np.arange(4)[:, None] * [1e-3, 1e-3, 0.0], (capacity * _BOX_QUADS, 1))
     ET.SubElement(
         asset, "mesh", name=WALL_MESH, inertia="shell",
         vertex=" ".join(f"{v:.4f}" for v in verts.ravel()),
         face=" ".join(str(f) for f in faces.ravel()),
+        texcoord=" ".join(f"{v:.4f}" for v in texcoords.ravel()),
     )
     ET.SubElement(worldbody, "geom", name="walls_visual", type="mesh", mesh=WALL_MESH, material="wall")
     # The floor after the walls: MuJoCo draws geoms in model order, so floor
@@ -129,29 +155,120 @@ def build_xml(grid_size: int, cell_size: float, objects: Sequence[ObjectGeom] = 
     return ET.tostring(root, encoding="unicode")
 
 
-def _box_mesh(boxes: np.ndarray):
-    """Vertices, faces, normals and face-normal indices of boxes ``(x, y, hx, hy)``
-    standing on the floor, ``WALL_HEIGHT`` tall, as one mesh."""
+def _add_textures(root: ET.Element) -> None:
+    """Textures on the wall and floor materials, and light that fades with distance."""
+    asset = root.find("asset")
+    for name in ("wall", "floor"):
+        # builtin="flat" only sizes the texture: paint_textures fills it.
+        ET.SubElement(
+            asset, "texture", name=name, type="2d", builtin="flat",
+            width=str(TEXTURE_TEXELS), height=str(TEXTURE_TEXELS), rgb1="1 1 1",
+        )
+        # GL multiplies the grey texels by the material's colour: brighten it
+        # so a surface keeps the flat style's mean colour (and maps, drawn
+        # without textures, keep its hue).
+        material = asset.find(f"material[@name='{name}']")
+        material.set("texture", name)
+        rgba = np.array(material.get("rgba").split(), dtype=float)
+        rgba[:3] = np.minimum(rgba[:3] * _TEXTURE_GAIN[name], 1.0)
+        material.set("rgba", " ".join(f"{v:.3f}" for v in rgba))
+    # The floor repeats its texture once per metre; the wall mesh carries
+    # texture coordinates in metres.
+    asset.find("material[@name='floor']").set("texuniform", "true")
+    asset.find("material[@name='floor']").set("texrepeat", "1 1")
+    _add_distance_falloff(root)
+
+
+def _add_distance_falloff(root: ET.Element) -> None:
+    """A lamp at the agent's eye whose light fades with distance, instead of the headlight.
+
+    Doom darkens what is far ("light diminishing"); memory-maze and DeepMind
+    Lab shade with distance too. A point light with attenuation is computed at
+    vertices, so it costs next to nothing per pixel (fog, per pixel, cost
+    about twice as much on llvmpipe); the wall mesh is cut into pieces of at
+    most 1 m and the floor is a grid of one-cell quads, so the fall-off is
+    smooth along both. Brightness ~ 1 / (0.7 + 0.3 d): 1 at 1 m, 0.53 at 4 m,
+    0.32 at 8 m, times the angle to the surface.
+    """
+    visual = root.find("visual")
+    visual.find("headlight").set("active", "0")
+    agent = root.find("worldbody/body[@name='agent']")
+    ET.SubElement(
+        agent, "light", name=LAMP, pos=f"0 0 {EYE_HEIGHT}", dir="1 0 0", directional="false", castshadow="false",
+        attenuation="0.7 0.3 0", cutoff="180", ambient="0.75 0.75 0.75", diffuse="0.35 0.35 0.35", specular="0 0 0",
+    )
+
+
+def paint_textures(model: mujoco.MjModel) -> None:
+    """Fills the wall and floor textures of a ``"textured"`` model (a fixed pattern, the same everywhere)."""
+    for name, texels in (("wall", _brick_texels()), ("floor", _tile_texels())):
+        texture = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXTURE, name)
+        if texture < 0:
+            continue
+        adr, size = model.tex_adr[texture], texels.size
+        model.tex_data[adr : adr + size] = texels.ravel()
+
+
+def _brick_texels() -> np.ndarray:
+    """Bricks 0.25 x 0.125 m in courses offset by half a brick, dark mortar, grain (grey, mean ~1/_TEXTURE_GAIN)."""
+    n = TEXTURE_TEXELS
+    rng = np.random.default_rng(1)
+    rows, cols = np.mgrid[0:n, 0:n]
+    course = rows * 8 // n  # 8 courses per metre
+    shifted = (cols + (course % 2) * n // 8) % n  # every other course offset by half a brick
+    grey = rng.uniform(0.72, 1.0, size=(8, 4))[course, shifted * 4 // n] * rng.uniform(0.9, 1.0, size=(n, n))
+    grey[(rows % (n // 8) == 0) | (shifted % (n // 4) == 0)] = 0.4  # mortar
+    return _grey_to_rgb(grey)
+
+
+def _tile_texels() -> np.ndarray:
+    """Tiles 0.5 m with light grout lines and mottled grain (grey, mean ~1/_TEXTURE_GAIN)."""
+    n = TEXTURE_TEXELS
+    rng = np.random.default_rng(2)
+    rows, cols = np.mgrid[0:n, 0:n]
+    tile = (rows * 2 // n) * 2 + cols * 2 // n
+    grey = rng.uniform(0.6, 0.8, size=4)[tile] * rng.uniform(0.85, 1.0, size=(n, n))
+    grey[(rows % (n // 2) == 0) | (cols % (n // 2) == 0)] = 1.0  # grout
+    return _grey_to_rgb(grey)
+
+
+def _grey_to_rgb(grey: np.ndarray) -> np.ndarray:
+    return np.repeat((np.clip(grey, 0, 1) * 255).astype(np.uint8)[..., None], 3, axis=2)
+
+
+def _box_mesh(boxes: np.ndarray, keep: np.ndarray | None = None):
+    """Vertices, faces, normals, face-normal indices and texture coordinates of
+    boxes ``(x, y, hx, hy)`` standing on the floor, ``WALL_HEIGHT`` tall, as one mesh.
+
+    ``keep`` ``(boxes, 5)`` says which quads to draw (sides y-, x+, y+, x-, then
+    the top); default all.
+
+    Texture coordinates are world metres (along the wall, up the wall; ``x, y``
+    on the top), so a texel has the same size on every wall whatever its length.
+    """
     k = len(boxes)
-    x, y, hx, hy = (boxes[:, i : i + 1] for i in range(4))
-    corner_x = np.hstack([x - hx, x + hx, x + hx, x - hx])  # counter-clockwise from above
-    corner_y = np.hstack([y - hy, y - hy, y + hy, y + hy])
-    verts = np.zeros((k, _BOX_VERTS, 3))
-    verts[:, :4, 0] = verts[:, 4:, 0] = corner_x
-    verts[:, :4, 1] = verts[:, 4:, 1] = corner_y
-    verts[:, 4:, 2] = WALL_HEIGHT
-
-    local_faces = []
-    for a, b in _SIDE_CORNERS:  # outward-facing, counter-clockwise
-        local_faces += [(a, b, b + 4), (a, b + 4, a + 4)]
-    local_faces += [(4, 5, 6), (4, 6, 7)]
-    faces = np.array(local_faces)[None] + (np.arange(k) * _BOX_VERTS)[:, None, None]
-
+    x, y, hx, hy = (boxes[:, i] for i in range(4))
+    corner_x = np.stack([x - hx, x + hx, x + hx, x - hx], axis=1)  # counter-clockwise from above
+    corner_y = np.stack([y - hy, y - hy, y + hy, y + hy], axis=1)
+    verts = np.zeros((k, _BOX_QUADS, 4, 3))
+    texcoords = np.zeros((k, _BOX_QUADS, 4, 2))
+    for side, (a, b) in enumerate(_SIDE_CORNERS):  # quad: a bottom, b bottom, b top, a top
+        for corner, (c, z) in enumerate(((a, 0.0), (b, 0.0), (b, WALL_HEIGHT), (a, WALL_HEIGHT))):
+            verts[:, side, corner] = np.stack([corner_x[:, c], corner_y[:, c], np.full(k, z)], axis=1)
+            along = corner_x[:, c] if side % 2 == 0 else corner_y[:, c]  # sides 0, 2 run along x
+            texcoords[:, side, corner] = np.stack([along, np.full(k, z)], axis=1)
+    for corner in range(4):  # the top
+        verts[:, 4, corner] = np.stack([corner_x[:, corner], corner_y[:, corner], np.full(k, WALL_HEIGHT)], axis=1)
+        texcoords[:, 4, corner] = np.stack([corner_x[:, corner], corner_y[:, corner]], axis=1)
     side_normals = np.array([(0, -1, 0), (1, 0, 0), (0, 1, 0), (-1, 0, 0), (0, 0, 1)], dtype=np.float64)
     normals = np.broadcast_to(side_normals, (k, _BOX_NORMALS, 3))
-    local_face_normal = np.repeat(np.arange(_BOX_NORMALS), 2)[:, None].repeat(3, axis=1)
-    face_normals = local_face_normal[None] + (np.arange(k) * _BOX_NORMALS)[:, None, None]
-    return verts.reshape(-1, 3), faces.reshape(-1, 3), normals.reshape(-1, 3), face_normals.reshape(-1, 3)
+    keep = np.ones((k, _BOX_QUADS), dtype=bool) if keep is None else keep
+    verts, texcoords, normals = verts[keep], texcoords[keep], normals[keep]  # (quads, 4, ...), (quads, 3)
+    quads = len(verts)
+    quad = np.array([(0, 1, 2), (0, 2, 3)])  # outward-facing, counter-clockwise
+    faces = quad[None] + (np.arange(quads) * 4)[:, None, None]
+    face_normals = np.repeat(np.arange(quads), 2)[:, None].repeat(3, axis=1)
+    return verts.reshape(-1, 3), faces.reshape(-1, 3), normals, face_normals, texcoords.reshape(-1, 2)
 
 
 class WallLayout:
@@ -182,6 +299,11 @@ class WallLayout:
         self._faces = model.mesh_face[face_adr : face_adr + n * _BOX_FACES]
         self._face_normals = model.mesh_facenormal[face_adr : face_adr + n * _BOX_FACES]
         self._normals = model.mesh_normal[normal_adr : normal_adr + n * _BOX_NORMALS]
+        texcoord_adr = model.mesh_texcoordadr[self.mesh_id]
+        self._texcoords = model.mesh_texcoord[texcoord_adr : texcoord_adr + n * _BOX_VERTS]
+        self._face_texcoords = model.mesh_facetexcoord[face_adr : face_adr + n * _BOX_FACES]
+        if len(self._verts) < n * _BOX_VERTS or len(self._texcoords) < n * _BOX_VERTS:
+            raise RuntimeError("the compiled wall mesh is smaller than its placeholder: vertices were merged")
 
     def apply(self, h_walls: np.ndarray, v_walls: np.ndarray) -> None:
         model = self._model
@@ -195,11 +317,13 @@ class WallLayout:
         # Visual mesh: one box per straight run of walls, and only as many faces
         # as they need (mjr_uploadMesh sends mesh_facenum faces): fewer vertices
         # for the rasteriser, whatever the grid's capacity.
-        verts, faces, normals, face_normals = _box_mesh(wall_runs(h_walls, v_walls, self._cell_size))
+        verts, faces, normals, face_normals, texcoords = _box_mesh(*wall_pieces(h_walls, v_walls, self._cell_size))
         self._verts[: len(verts)] = verts
         self._faces[: len(faces)] = faces
         self._face_normals[: len(face_normals)] = face_normals
         self._normals[: len(normals)] = normals
+        self._texcoords[: len(texcoords)] = texcoords
+        self._face_texcoords[: len(faces)] = faces
         model.mesh_facenum[self.mesh_id] = len(faces)
 
 
@@ -216,6 +340,42 @@ def wall_runs(h_walls: np.ndarray, v_walls: np.ndarray, cell_size: float) -> np.
             y0, y1 = (start - 0.5 - half) * cell_size, (stop - 0.5 - half) * cell_size
             boxes.append(((line - 0.5 - half) * cell_size, (y0 + y1) / 2, thick, (y1 - y0) / 2 + thick))
     return np.array(boxes, dtype=np.float64).reshape(-1, 4)
+
+
+# Longest piece of wall in the visual mesh: the light's fall-off is computed at
+# vertices (fixed-function GL) and interpolated, so a long run is cut into
+# pieces to keep its far end darker than its near end.
+MAX_PIECE_LENGTH = 1.0
+
+
+def _pieces_per_segment(cell_size: float) -> int:
+    """Upper bound on mesh pieces per wall segment (a run of L segments has at most L times this)."""
+    return math.ceil((cell_size + WALL_THICKNESS) / MAX_PIECE_LENGTH)
+
+
+def wall_pieces(h_walls: np.ndarray, v_walls: np.ndarray, cell_size: float) -> tuple[np.ndarray, np.ndarray]:
+    """The visual walls: runs of walls cut into pieces of at most :data:`MAX_PIECE_LENGTH`.
+
+    Returns boxes ``(x, y, hx, hy)`` and which of each box's quads to draw
+    (``(boxes, 5)``: sides y-, x+, y+, x-, top): a cut between two pieces of a
+    run draws no end faces, which would be hidden inside the wall.
+    """
+    boxes, keep = [], []
+    for x, y, hx, hy in wall_runs(h_walls, v_walls, cell_size):
+        along_x = hx >= hy
+        length = 2 * (hx if along_x else hy)
+        count = math.ceil(length / MAX_PIECE_LENGTH - 1e-9)
+        half = length / count / 2
+        for i in range(count):
+            offset = -length / 2 + (2 * i + 1) * half
+            first, last = i == 0, i == count - 1
+            if along_x:
+                boxes.append((x + offset, y, half, hy))
+                keep.append((True, last, True, first, True))
+            else:
+                boxes.append((x, y + offset, hx, half))
+                keep.append((first, True, last, True, True))
+    return np.array(boxes, dtype=np.float64).reshape(-1, 4), np.array(keep, dtype=bool).reshape(-1, _BOX_QUADS)
 
 
 def _runs(flags: np.ndarray) -> list[tuple[int, int]]:

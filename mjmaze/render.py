@@ -157,6 +157,27 @@ def gl_backend() -> str | None:
     return _gl_backend if _gl_pid == os.getpid() else None
 
 
+def _sample_nearest(context: mujoco.MjrContext) -> None:
+    """Nearest-texel sampling without mipmaps for the context's 2-D textures.
+
+    Doom draws its textures unfiltered, and on llvmpipe MuJoCo's trilinear
+    mipmapped sampling made a textured frame cost about twice a flat one
+    (bench/speed.py). MuJoCo has no setting for this, so the texture objects it
+    made are changed through PyOpenGL (a dependency of mujoco), in the current
+    context.
+    """
+    if not context.ntexture:
+        return
+    from OpenGL import GL  # after gl_context() has fixed PyOpenGL's platform
+
+    for texture, kind in zip(context.texture[: context.ntexture], context.textureType[: context.ntexture]):
+        if kind == mujoco.mjtTexture.mjTEXTURE_2D:
+            GL.glBindTexture(GL.GL_TEXTURE_2D, int(texture))
+            GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MIN_FILTER, GL.GL_NEAREST)
+            GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MAG_FILTER, GL.GL_NEAREST)
+    GL.glBindTexture(GL.GL_TEXTURE_2D, 0)
+
+
 class EgoRenderer:
     """Renders one camera of one model into a reused uint8 RGB buffer.
 
@@ -164,12 +185,18 @@ class EgoRenderer:
     context (meshes are per model, and the wall mesh is rewritten per maze).
     """
 
-    def __init__(self, model: mujoco.MjModel, camera: str, width: int, height: int):
+    def __init__(self, model: mujoco.MjModel, camera: str, width: int, height: int, map_view: bool = False):
+        """``map_view``: for top-down maps, light the scene evenly from straight
+        above instead of with the model's lights (the textured style's lamp sits
+        at the agent's eye and fades with distance), and draw no textures, so
+        the floor is one colour under drawn paths."""
         gl_context()
+        self._map_view = map_view
         model.vis.global_.offwidth = max(model.vis.global_.offwidth, width)
         model.vis.global_.offheight = max(model.vis.global_.offheight, height)
         self._model = model
         self._context = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_50)
+        _sample_nearest(self._context)
         self._scene = mujoco.MjvScene(model, maxgeom=max(model.ngeom, 1))
         for flag in (
             mujoco.mjtRndFlag.mjRND_SHADOW,
@@ -181,6 +208,7 @@ class EgoRenderer:
             self._scene.flags[flag] = 0
         self._option = mujoco.MjvOption()
         self._option.geomgroup[:] = _VISIBLE_GROUPS
+        self._option.flags[mujoco.mjtVisFlag.mjVIS_TEXTURE] = not map_view
         self._perturb = mujoco.MjvPerturb()
         self._camera = mujoco.MjvCamera()
         self._camera.type = mujoco.mjtCamera.mjCAMERA_FIXED
@@ -206,10 +234,25 @@ class EgoRenderer:
         mujoco.mj_kinematics(self._model, data)
         mujoco.mj_camlight(self._model, data)
         mujoco.mjv_updateScene(self._model, data, self._option, self._perturb, self._camera, self._catmask, self._scene)
+        if self._map_view:
+            self._light_from_above()
         mujoco.mjr_setBuffer(self._offscreen, self._context)
         mujoco.mjr_render(self._viewport, self._scene, self._context)
         mujoco.mjr_readPixels(self._buffer, None, self._viewport, self._context)
         return self._frame
+
+    def _light_from_above(self) -> None:
+        self._scene.nlight = 1
+        light = self._scene.lights[0]
+        light.type = mujoco.mjtLightType.mjLIGHT_DIRECTIONAL
+        light.headlight = 0
+        light.castshadow = 0
+        light.pos = (0.0, 0.0, 10.0)
+        light.dir = (0.0, 0.0, -1.0)
+        light.attenuation = (1.0, 0.0, 0.0)
+        light.ambient = (0.45, 0.45, 0.45)
+        light.diffuse = (0.55, 0.55, 0.55)
+        light.specular = (0.0, 0.0, 0.0)
 
     def close(self) -> None:
         if self._context is not None:

@@ -49,7 +49,9 @@ class TopDown:
         self.size = int(size)
         layout = self.task.layout
         self.extent = mjcf.overhead_extent(layout.grid_size, layout.cell_size)
-        self._renderer = render.EgoRenderer(self.physics.model.ptr, mjcf.OVERHEAD_CAMERA, self.size, self.size)
+        self._renderer = render.EgoRenderer(
+            self.physics.model.ptr, mjcf.OVERHEAD_CAMERA, self.size, self.size, map_view=True
+        )
         self._wall_mesh = self.physics.model.ptr.mesh(mjcf.WALL_MESH).id
 
     def to_pixels(self, xy) -> np.ndarray:

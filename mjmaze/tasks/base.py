@@ -135,9 +135,13 @@ class MazeTask(base.Task):
         width: int = DEFAULT_WIDTH,
         height: int = DEFAULT_HEIGHT,
         layouts: str | os.PathLike | None = None,
+        visual_style: str = "textured",
         random=None,
     ):
         super().__init__(random=random)
+        _check_choice("visual_style", visual_style, mjcf.VISUAL_STYLES)
+        #: "textured" (default: the depth cues of the paper's frames) or "flat" (cheaper); see mjmaze.mjcf.
+        self.visual_style = visual_style
         _check_choice("split", split, configs.SPLITS)
         _check_choice("config_sampling", config_sampling, configs.CONFIG_SAMPLING)
         _check_choice("action_set", action_set, tuple(ACTION_SETS))
@@ -320,8 +324,9 @@ class MazeTask(base.Task):
 
 def make_environment(task: MazeTask, environment_kwargs: dict | None = None) -> control.Environment:
     """Compiles the task's arena and wraps it in a dm_control environment."""
-    xml = mjcf.build_xml(task.layout.grid_size, task.layout.cell_size, task.objects)
+    xml = mjcf.build_xml(task.layout.grid_size, task.layout.cell_size, task.objects, task.visual_style)
     physics = MazePhysics.from_xml_string(xml)
+    mjcf.paint_textures(physics.model.ptr)
     kwargs = dict(n_sub_steps=TICS_PER_STEP, legacy_step=False)
     kwargs.update(environment_kwargs or {})
     return control.Environment(physics, task, **kwargs)
