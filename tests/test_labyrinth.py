@@ -82,8 +82,8 @@ def test_a_wall_stops_a_forward_run(index):
         env.step(FORWARD)
         px = env.physics.agent_pose()[0]
         assert px <= wall_face - 0.05, "the agent reached into the wall"
-    # It is stopped at its radius (0.125 m) from the wall, give or take a bounce.
-    assert px == pytest.approx(wall_face - base.AGENT_RADIUS, abs=0.04)
+    # It is stopped at its radius (0.125 m) from the wall.
+    assert px == pytest.approx(wall_face - base.AGENT_RADIUS, abs=0.01)
     env.task.close()
 
 

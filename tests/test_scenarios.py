@@ -60,7 +60,7 @@ def test_pillars_block_movement_and_stay_touchable():
         env.step(FORWARD)
     x = env.physics.agent_pose()[0]
     # Stopped at its radius + the pillar's (0.25 m), inside the 0.3 m touch range.
-    assert red[0] - x == pytest.approx(0.25, abs=0.03)
+    assert red[0] - x == pytest.approx(0.25, abs=0.01)
     assert env.task.metrics()["target_found"]
 
 
@@ -261,7 +261,7 @@ def test_totem_blocks_movement():
     for _ in range(5):
         env.task.health = 100
         env.step(FORWARD)
-    assert env.physics.agent_pose()[0] == pytest.approx(-0.25, abs=0.03)
+    assert env.physics.agent_pose()[0] == pytest.approx(-0.25, abs=0.01)
 
 
 def test_complexity_out_of_range_is_a_clear_error():

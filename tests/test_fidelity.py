@@ -1,0 +1,243 @@
+"""What the agent sees and how rules fire, checked against the paper's ViZDoom scenarios.
+
+Frames carry depth cues (textures of a fixed size in the world, light that
+fades with distance); pick-ups are tested every tic; walls and pillars stop the
+agent at its radius; Two-colour items cover the floor the agent can stand on;
+the released generator's Two-colour layouts import and play.
+"""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+import mjmaze
+from mjmaze import layouts, mjcf
+from mjmaze.tasks import base, find_return, k_item, two_colour
+
+from conftest import FORWARD, TURN_LEFT, place
+
+STEP = -0.0004
+TOLERANCE = 0.01  # metres: the agent stops at its radius within this
+
+
+def load(name, **kwargs):
+    env = mjmaze.load(name, task_kwargs={"random": 0, **kwargs})
+    env.reset()
+    return env
+
+
+# -- frames ---------------------------------------------------------------------
+
+
+def distinct_colours(frame):
+    return len(np.unique(frame.reshape(-1, 3), axis=0))
+
+
+@pytest.mark.parametrize("style, fewest", [("textured", 48), ("flat", 1)])
+def test_frames_on_a_random_walk_have_dozens_of_colours(style, fewest):
+    env = load("labyrinth", size=9, visual_style=style)
+    actions = np.random.default_rng(0).integers(5, size=150)
+    counts = [distinct_colours(env.step(a).observation["pixels"]) for a in actions]
+    assert np.median(counts) >= fewest
+    if style == "flat":  # the flat look is what the fidelity audit found: a handful of colours
+        assert np.median(counts) < 16
+
+
+def wall_brightness(env, distance):
+    """Mean brightness of the frame's centre, facing the +x outer wall of an empty arena from ``distance`` m."""
+    face = env.task.config.size * env.task.config.cell_size / 2 - mjcf.WALL_THICKNESS / 2
+    values = []
+    for y in np.linspace(-2.0, 2.0, 9):  # average over the brick pattern
+        place(env, face - distance, y, 0.0)
+        frame = env.task.get_observation(env.physics)["pixels"].astype(float)
+        values.append(frame[26:38, 46:66].mean())
+    return np.mean(values)
+
+
+def test_a_wall_is_darker_far_away_than_near():
+    # Two-colour at complexity 0 is an empty 10 m arena; no items in view.
+    env = load("two_colour", complexity=0, item_cap=0)
+    near, far = wall_brightness(env, 1.0), wall_brightness(env, 4.0)
+    assert far < 0.8 * near, (near, far)
+
+
+@pytest.mark.parametrize("style, distinct", [("textured", 4), ("flat", 1)])
+def test_views_ninety_degrees_apart_differ_at_a_symmetric_spot(style, distinct):
+    # The centre of the empty arena, totem hidden: four views the flat look draws alike.
+    env = load("two_colour", complexity=0, item_cap=0, visual_style=style)
+    env.physics.show_objects(env.task._totem_geom, False)
+    frames = []
+    for yaw in (0.0, math.pi / 2, math.pi, -math.pi / 2):
+        place(env, 0.0, 0.0, yaw)
+        frames.append(env.task.get_observation(env.physics)["pixels"].tobytes())
+    assert len(set(frames)) == distinct
+
+
+def test_texels_keep_their_size_on_walls_of_any_length():
+    # Texture coordinates are metres along the wall and up it, whatever the run.
+    boxes = np.array([[0.0, 0.0, 2.0, 0.0625], [5.0, 0.0, 0.5, 0.0625]])
+    verts, _, _, _, texcoords = mjcf._box_mesh(boxes)
+    for box in range(2):
+        quad = slice(box * 20, box * 20 + 4)  # the y- side: along x
+        assert np.allclose(texcoords[quad, 0], verts[quad, 0])
+        assert np.allclose(texcoords[quad, 1], verts[quad, 2])
+
+
+# -- pick-ups every tic ---------------------------------------------------------
+
+
+def beside(env, xy):
+    """0.125 m before ``xy`` in x and 0.28 m to its side, facing +x: out of reach (0.307 m)
+    before and after one forward step, in reach at its middle."""
+    place(env, xy[0] - 0.125, xy[1] + 0.28, 0.0)
+    assert math.hypot(0.125, 0.28) > base.PICKUP_RADIUS
+
+
+def test_an_exit_passed_mid_step_is_reached():
+    env = load("labyrinth", size=7)
+    config = env.task.config
+    beside(env, config.cell_centre(config.object_cells[0]))
+    timestep = env.step(FORWARD)
+    assert timestep.last() and timestep.reward == pytest.approx(1.0 + STEP)
+    assert env.task.metrics()["success"]
+
+
+def test_a_wrong_item_passed_mid_step_ends_the_episode():
+    env = load("k_item", num_items=4)
+    config = env.task.config
+    beside(env, config.cell_centre(config.object_cells[2]))  # kind 3 while kind 1 is next
+    timestep = env.step(FORWARD)
+    assert timestep.last() and timestep.reward == pytest.approx(k_item.WRONG_ITEM_REWARD + STEP)
+
+
+def test_a_two_colour_item_passed_mid_step_is_picked_up():
+    env = load("two_colour", complexity=0)
+    task = env.task
+    task.item_xy[:] = (4.5, 4.5)  # every item out of the way but one
+    task.item_xy[0] = (-2.0, -3.0)
+    env.physics.place_objects(task._item_mocap, task.item_xy)
+    beside(env, task.item_xy[0])
+    env.step(FORWARD)
+    assert not task.item_active[0]
+    assert task.item_active[1:20].all()
+
+
+# -- contacts -------------------------------------------------------------------
+
+
+def push(env, action, steps):
+    """The agent's (x, y) after every tic of ``steps`` agent steps."""
+    path = []
+    for _ in range(steps):
+        env.step(action)
+        path.append(env.physics.tic_xy.copy())
+    return np.concatenate(path)
+
+
+@pytest.mark.parametrize("heading", [0.0, 30.0])
+def test_the_agent_stops_at_its_radius_from_a_wall_at_every_tic(heading):
+    env = load("two_colour", complexity=0, item_cap=0)
+    face = 5.0 - mjcf.WALL_THICKNESS / 2
+    place(env, face - 1.0, -2.0, math.radians(heading))
+    env.task.health = 10**6  # no death in 50 steps
+    path = push(env, FORWARD, 50)
+    gap = face - path[:, 0]  # centre to wall face
+    assert gap.min() >= base.AGENT_RADIUS - TOLERANCE
+    assert gap[-40:].max() <= base.AGENT_RADIUS + TOLERANCE  # resting against it, no bounce
+    if heading:
+        assert path[-1, 1] > -2.0 + 5.0  # slid along the wall
+
+
+def test_the_agent_stops_at_its_radius_from_a_pillar_at_every_tic():
+    env = load("find_return", size=7)
+    red = env.task.config.cell_centre(env.task.config.object_cells[0])
+    place(env, red[0] - 0.45, red[1], 0.0)
+    path = push(env, FORWARD, 50)
+    distance = np.hypot(path[:, 0] - red[0], path[:, 1] - red[1])
+    stop = find_return.PILLAR_RADIUS + base.AGENT_RADIUS
+    assert distance.min() >= stop - TOLERANCE
+    assert distance[-40:].max() <= stop + TOLERANCE
+    assert env.task.metrics()["target_found"]
+
+
+# -- Two-colour items -------------------------------------------------------------
+
+
+def distance_to_walls(config, xy):
+    boxes = mjcf.wall_runs(config.h_walls, config.v_walls, config.cell_size)
+    gap_x = np.maximum(np.abs(xy[:, None, 0] - boxes[:, 0]) - boxes[:, 2], 0)
+    gap_y = np.maximum(np.abs(xy[:, None, 1] - boxes[:, 1]) - boxes[:, 3], 0)
+    return np.hypot(gap_x, gap_y).min(axis=1)
+
+
+def test_items_cover_the_floor_the_agent_can_stand_on():
+    env = mjmaze.load("two_colour", task_kwargs={"complexity": 1, "random": 0})
+    near_open_edge = total = 0
+    for _ in range(30):
+        env.reset()
+        task, config = env.task, env.task.config
+        xy = task.item_xy[task.item_active]
+        assert (distance_to_walls(config, xy) >= base.AGENT_RADIUS).all()
+        assert (np.hypot(*xy.T) >= two_colour.TOTEM_CLEARANCE).all()  # the totem is at the origin
+        # Within 0.25 m of a cell edge: 44% of a cell's area; the old rule gave 0%.
+        offset = np.abs((xy + config.size * config.cell_size / 2) % config.cell_size - config.cell_size / 2)
+        near_open_edge += int((offset.max(axis=1) > config.cell_size / 2 - 0.25).sum())
+        total += len(xy)
+    assert 0.3 < near_open_edge / total < 0.5
+
+
+# -- the released Two-colour layouts -------------------------------------------
+
+
+def released_two_colour(walls, spawn_cell):
+    """A layout as the released generator wrote it: 256-unit cells, the maze from
+    -768 to 512 (``-size // 2 * cell``), only interior walls, the totem spot at
+    (-128, -128), the centre cell."""
+    low, cell = -768, 256
+    centre = lambda c: low + c * cell + cell / 2  # noqa: E731
+    return {
+        "start": [centre(spawn_cell[1]), centre(spawn_cell[0])],
+        "end": [-128.0, -128.0],
+        "exterior": [[low, low], [low, low + 5 * cell], [low + 5 * cell, low + 5 * cell], [low + 5 * cell, low]],
+        "walls": walls,
+    }
+
+
+def test_a_released_layout_without_interior_walls_imports_and_plays(tmp_path):
+    path = tmp_path / "two_color_maze000.json"
+    path.write_text(json.dumps(released_two_colour([], (0, 0))))
+    config = layouts.from_paper_json(path, "two_colour")
+    assert not config.h_walls[1:-1].any() and not config.v_walls[:, 1:-1].any()
+    assert config.h_walls[[0, -1]].all() and config.v_walls[:, [0, -1]].all()
+    env = load("two_colour", layouts=str(tmp_path))
+    assert env.task.config.spawn_cell == (0, 0)
+    assert env.step(FORWARD).reward > 0
+
+
+def test_a_released_spawn_in_the_totem_cell_plays_as_released(tmp_path):
+    wall = [-512.0, -256.0, -256.0, -256.0]  # one interior wall, away from the centre
+    (tmp_path / "two_color_maze001.json").write_text(json.dumps(released_two_colour([wall], (2, 2))))
+    env = load("two_colour", layouts=str(tmp_path), item_cap=0)
+    assert env.task.config.spawn_cell == env.task.config.object_cells[0] == (2, 2)
+    x, y, yaw = env.physics.agent_pose()
+    assert (x, y, yaw) == (0.0, 0.0, 0.0)  # inside the totem, facing +x
+    for _ in range(4):
+        env.step(FORWARD)
+    x, _, _ = env.physics.agent_pose()
+    assert x == pytest.approx(1.0, abs=0.01)  # walked out of it freely
+    for _ in range(12):  # turn round (180 degrees) and walk back: now it blocks
+        env.step(TURN_LEFT)
+    path = push(env, FORWARD, 8)
+    assert np.hypot(*path.T).min() >= two_colour.TOTEM_CLEARANCE - TOLERANCE
+
+
+def test_other_scenarios_still_refuse_a_spawn_on_an_object(tmp_path):
+    data = released_two_colour([], (2, 2))
+    data["exterior"] = [[-320, -320], [-320, 320], [320, 320], [320, -320]]
+    data["start"] = data["end"] = [0.0, 0.0]
+    path = tmp_path / "lab.json"
+    path.write_text(json.dumps(data))
+    with pytest.raises(layouts.LayoutError, match="shares a cell"):
+        layouts.from_paper_json(path, "labyrinth")
