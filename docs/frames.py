@@ -38,7 +38,7 @@ def best_view(name: str, task_kwargs: dict) -> np.ndarray:
                 frame = task.get_observation(physics)["pixels"]
                 # Saturated pixels are objects (walls, floor and sky are muted).
                 rgb = frame.astype(int)
-                score = ((rgb.max(axis=-1) - rgb.min(axis=-1)) > 120).sum()
+                score = ((rgb.max(axis=-1) - rgb.min(axis=-1)) > 150).sum()
                 if score > best_score:
                     best, best_score = frame, score
     task.close()

@@ -75,13 +75,15 @@ class MazePhysics(mujoco.Physics):
         qpos, qvel, dt = data.qpos, data.qvel, model.opt.timestep
         if len(self.tic_xy) != nstep:
             self.tic_xy = np.zeros((nstep, 2))
+            self._ahead = np.zeros_like(qpos)
+        ahead, tic_xy = self._ahead, self.tic_xy
         with self.check_invalid_state():
             for tic in range(nstep):
-                ahead = qvel * dt
+                np.multiply(qvel, dt, out=ahead)
                 qpos += ahead
                 mj.mj_step(model, data)
                 qpos -= ahead
-                self.tic_xy[tic] = qpos[:2]
+                tic_xy[tic] = qpos[:2]
 
     def agent_pose(self) -> tuple[float, float, float]:
         """``(x, y, yaw)`` of the agent; yaw in radians in ``(-pi, pi]``, 0 facing +x."""
@@ -351,6 +353,15 @@ def within_pickup(xy, x: float, y: float) -> bool:
     return dx * dx + dy * dy < PICKUP_RADIUS * PICKUP_RADIUS
 
 
+def touches(xy, path: np.ndarray) -> bool:
+    """True if ``path`` (the agent's positions after each tic of a step) comes within pick-up range of ``xy``."""
+    px, py = xy
+    for x, y in path.tolist():  # 4 tics: plain floats beat numpy's per-call cost
+        if (x - px) ** 2 + (y - py) ** 2 < PICKUP_RADIUS * PICKUP_RADIUS:
+            return True
+    return False
+
+
 def reached(points: np.ndarray, path: np.ndarray) -> np.ndarray:
     """The first tic at which ``path`` comes within pick-up range of each of ``points``, -1 if none.
 
@@ -358,8 +369,20 @@ def reached(points: np.ndarray, path: np.ndarray) -> np.ndarray:
     each tic of a step (:attr:`MazePhysics.tic_xy`).
     """
     points = np.asarray(points, dtype=float).reshape(-1, 2)
-    close = ((points[:, None, :] - path[None, :, :]) ** 2).sum(axis=2) < PICKUP_RADIUS * PICKUP_RADIUS
-    return np.where(close.any(axis=1), close.argmax(axis=1), -1)
+    first = np.full(len(points), -1)
+    tics = path.tolist()
+    end_x, end_y = tics[-1]
+    # Only points near the step's end can be in reach at some tic: one numpy
+    # pass finds them (Two-colour has up to 90), then each is checked per tic.
+    reach = PICKUP_RADIUS + max(math.hypot(x - end_x, y - end_y) for x, y in tics)
+    near = np.flatnonzero(((points - tics[-1]) ** 2).sum(axis=1) < reach * reach)
+    for k in near.tolist():
+        px, py = points[k].tolist()
+        for tic, (x, y) in enumerate(tics):
+            if (x - px) ** 2 + (y - py) ** 2 < PICKUP_RADIUS * PICKUP_RADIUS:
+                first[k] = tic
+                break
+    return first
 
 
 def _check_choice(name: str, value, valid: Sequence) -> None:

@@ -71,12 +71,11 @@ class FindReturn(base.MazeTask):
     def scenario_step(self, physics: base.MazePhysics, path) -> tuple[float, bool]:
         # The pillars stand in different cells, more than a step apart: one
         # step never touches both, so target and return are checked in turn.
-        red_tic, green_tic = base.reached([self._red_xy, self._green_xy], path)
         if not self._target_found:
-            if red_tic >= 0:
+            if base.touches(self._red_xy, path):
                 self._target_found = True
                 return STEP_REWARD + TARGET_REWARD, False
-        elif green_tic >= 0:
+        elif base.touches(self._green_xy, path):
             self._success = True
             return STEP_REWARD + RETURN_REWARD, True
         return STEP_REWARD, False

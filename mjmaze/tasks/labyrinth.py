@@ -52,7 +52,7 @@ class Labyrinth(base.MazeTask):
         self._success = False
 
     def scenario_step(self, physics: base.MazePhysics, path) -> tuple[float, bool]:
-        if base.reached(self._exit_xy, path)[0] >= 0:
+        if base.touches(self._exit_xy, path):
             self._success = True
             return STEP_REWARD + EXIT_REWARD, True
         return STEP_REWARD, False
