@@ -4,14 +4,22 @@ SHELL := /bin/bash
 PYTHON ?= python3
 VENV ?= .venv
 PY := $(VENV)/bin/python
-# EGL (default) and OSMesa (fallback) for headless rendering.
-GL_PACKAGES := libegl1 libgl1 libgl1-mesa-dri libegl-mesa0 libglx-mesa0 libosmesa6
+# EGL (default) for headless rendering; OSMesa (the fallback) where the
+# distribution still ships it (newer Mesa releases dropped libosmesa6).
+GL_PACKAGES := libegl1 libgl1 libgl1-mesa-dri libegl-mesa0 libglx-mesa0
+OPTIONAL_GL_PACKAGES := libosmesa6
 # Installed only when no torch is there yet: install your own (a CUDA build,
 # say) into .venv first to train on a GPU.
 TORCH ?= torch==2.13.0
+# Where pip looks for torch; empty = PyPI (whose Linux torch is the multi-GB
+# CUDA build). Without an NVIDIA GPU: TORCH_INDEX=https://download.pytorch.org/whl/cpu
+TORCH_INDEX ?=
 # The main job: A2C on Labyrinth 5x5, sized to finish within ~15 minutes on 2 CPU cores.
 RUN_STEPS ?= 1000000
-RUN_NAME ?= labyrinth5_$(shell date +%Y%m%d-%H%M%S)
+# Expanded once (:=), so the train and evaluate lines name the same run.
+ifndef RUN_NAME
+RUN_NAME := labyrinth5_$(shell date +%Y%m%d-%H%M%S)
+endif
 
 .PHONY: run test bench setup system-deps clean
 
@@ -33,10 +41,17 @@ system-deps:
 	@if ! command -v dpkg >/dev/null; then \
 	  echo "Not a Debian system: install EGL or OSMesa yourself ($(GL_PACKAGES))."; exit 0; fi; \
 	missing=$$(for p in $(GL_PACKAGES); do dpkg -s $$p >/dev/null 2>&1 || echo $$p; done); \
-	if [ -z "$$missing" ]; then exit 0; fi; \
-	if [ "$$(id -u)" != 0 ]; then echo "Missing GL packages; run: sudo apt-get install $$missing"; exit 1; fi; \
-	echo "Installing GL packages: $$missing"; \
-	apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $$missing >/dev/null
+	optional=$$(for p in $(OPTIONAL_GL_PACKAGES); do dpkg -s $$p >/dev/null 2>&1 || echo $$p; done); \
+	if [ -z "$$missing$$optional" ]; then exit 0; fi; \
+	if [ "$$(id -u)" != 0 ]; then \
+	  if [ -n "$$missing" ]; then echo "Missing GL packages; run: sudo apt-get install $$missing"; exit 1; fi; \
+	  exit 0; fi; \
+	apt-get update -qq; \
+	if [ -n "$$missing" ]; then echo "Installing GL packages: $$missing"; \
+	  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $$missing >/dev/null || exit 1; fi; \
+	for p in $$optional; do \
+	  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $$p >/dev/null 2>&1 \
+	    || echo "$$p is not available here: rendering uses EGL only"; done
 
 $(VENV)/bin/python:
 	@$(PYTHON) -c 'import sys; sys.exit(sys.version_info < (3, 10))' || { echo "mjmaze needs Python >= 3.10"; exit 1; }
@@ -44,7 +59,7 @@ $(VENV)/bin/python:
 	$(PY) -m pip install -q --upgrade pip
 
 $(VENV)/.stamp-torch: | $(VENV)/bin/python
-	$(PY) -c 'import torch' 2>/dev/null || $(PY) -m pip install -q "$(TORCH)"
+	$(PY) -c 'import torch' 2>/dev/null || $(PY) -m pip install -q $(if $(TORCH_INDEX),--index-url $(TORCH_INDEX)) "$(TORCH)"
 	@touch $@
 
 $(VENV)/.stamp-%: pyproject.toml | $(VENV)/bin/python
