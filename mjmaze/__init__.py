@@ -10,32 +10,18 @@ Importing mjmaze picks no GL backend: see :mod:`mjmaze.render` (``MUJOCO_GL``).
 
 import warnings
 
-import gymnasium
-
 with warnings.catch_warnings():
     # dm_control tries GLFW when it is imported; without a display that only
     # warns. mjmaze never renders through dm_control, so the warning is noise.
     warnings.filterwarnings("ignore", module="glfw")
     from dm_control import mujoco as _dm_mujoco  # noqa: F401
 
-from mjmaze.suite import ALL_TASKS, load, task_kwarg_names  # noqa: E402
+from mjmaze import registry  # noqa: E402
+from mjmaze.suite import ALL_TASKS, load, register, task_kwarg_names  # noqa: E402
 
-__all__ = ["ALL_TASKS", "GYM_IDS", "load", "task_kwarg_names"]
+__all__ = ["ALL_TASKS", "GYM_IDS", "load", "register", "registry", "task_kwarg_names"]
 __version__ = "0.1.0"
 
-# scenario -> gymnasium id
-GYM_IDS = {
-    "labyrinth": "mjmaze/Labyrinth-v0",
-    "find_return": "mjmaze/FindReturn-v0",
-    "k_item": "mjmaze/KItem-v0",
-    "two_colour": "mjmaze/TwoColour-v0",
-}
-
-for _scenario, _env_id in GYM_IDS.items():
-    if _env_id not in gymnasium.registry:
-        gymnasium.register(
-            id=_env_id,
-            entry_point="mjmaze.gym_env:MazeEnv",
-            vector_entry_point="mjmaze.vector:MazeVectorEnv",
-            kwargs={"scenario": _scenario},
-        )
+#: scenario -> gymnasium id, for the scenarios that ship with mjmaze
+#: (``mjmaze.registry.get(name).gym_id`` for any registered one).
+GYM_IDS = {name: registry.get(name).gym_id for name in ALL_TASKS}

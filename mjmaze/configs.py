@@ -27,15 +27,14 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from mjmaze import maze
+from mjmaze import maze, registry
 
 SPLITS = ("train", "test")
 DEFAULT_NUM_CONFIGS = {"train": 256, "test": 64}
 CONFIG_SAMPLING = ("cycle", "random")
 
-# Fixed codes that enter every seed: changing them changes every maze.
+# Fixed codes that enter every seed (with each scenario's seed_code): changing them changes every maze.
 _ROOT_ENTROPY = 0x6D6A6D617A65  # "mjmaze" in ASCII
-_SCENARIO_CODES = {"labyrinth": 1, "find_return": 2, "k_item": 3, "two_colour": 4}
 _SPLIT_CODES = {"train": 0, "test": 1}
 
 
@@ -118,12 +117,11 @@ def generate_config(scenario: str, difficulty: int, split: str, index: int, spec
     """The configuration ``index`` of ``(scenario, difficulty, split)``."""
     if split not in SPLITS:
         raise ValueError(f"split must be one of {SPLITS}, got {split!r}")
-    if scenario not in _SCENARIO_CODES:
-        raise ValueError(f"unknown scenario {scenario!r}; valid: {tuple(_SCENARIO_CODES)}")
+    seed_code = registry.get(scenario).seed_code
     if index < 0:
         raise ValueError(f"index must be >= 0, got {index}")
     seed = np.random.SeedSequence(
-        [_ROOT_ENTROPY, _SCENARIO_CODES[scenario], int(difficulty), _SPLIT_CODES[split], int(index)]
+        [_ROOT_ENTROPY, seed_code, int(difficulty), _SPLIT_CODES[split], int(index)]
     )
     rng = np.random.default_rng(seed)
     n = spec.grid_size

@@ -16,7 +16,6 @@ as its configurations with ``layouts=<folder>``.
 
 from __future__ import annotations
 
-import importlib
 import json
 import math
 import os
@@ -24,7 +23,7 @@ import pathlib
 
 import numpy as np
 
-from mjmaze import configs
+from mjmaze import configs, registry
 
 DOOM_UNITS_PER_METRE = 128.0
 # How far (in cells) a coordinate may be off the grid and still snap to it.
@@ -35,17 +34,11 @@ class LayoutError(ValueError):
     """A layout file that cannot be read; the message names the file and the field."""
 
 
-def _task_module(scenario: str):
-    if scenario not in configs._SCENARIO_CODES:
-        raise ValueError(f"unknown scenario {scenario!r}; valid: {tuple(configs._SCENARIO_CODES)}")
-    return importlib.import_module(f"mjmaze.tasks.{scenario}")
-
-
 def from_paper_json(path: str | os.PathLike, scenario: str, index: int = 0, split: str = "paper") -> configs.MazeConfig:
     """Reads one configuration file of the paper's released implementation."""
     path = pathlib.Path(path)
-    module = _task_module(scenario)
-    cell = module.CELL_SIZE
+    declared = registry.get(scenario)
+    cell = declared.cell_size
 
     def fail(field: str, problem: str) -> LayoutError:
         return LayoutError(f"{path}: field {field!r}: {problem}")
@@ -109,18 +102,19 @@ def from_paper_json(path: str | os.PathLike, scenario: str, index: int = 0, spli
             raise fail(field_name, f"point {value!r} lies outside the maze")
         return int(math.floor(row)), int(math.floor(col))
 
-    if scenario == "k_item":
+    if declared.item_codes is not None:  # coloured items: their codes give the collection order
+        kind_of_code = {code: kind for kind, code in enumerate(declared.item_codes)}
         spawn = cell_of("spawn", field("spawn"))
         items = field("items")
         if not isinstance(items, list) or not items:
             raise fail("items", "expected a non-empty list of [x, y, code]")
         by_kind = {}
         for item in items:
-            if not (isinstance(item, list) and len(item) == 3 and str(item[2]) in module.KIND_OF_CODE):
-                raise fail("items", f"entry {item!r} is not [x, y, code] with code in {tuple(module.KIND_OF_CODE)}")
-            by_kind[module.KIND_OF_CODE[str(item[2])]] = cell_of("items", item[:2])
+            if not (isinstance(item, list) and len(item) == 3 and str(item[2]) in kind_of_code):
+                raise fail("items", f"entry {item!r} is not [x, y, code] with code in {declared.item_codes}")
+            by_kind[kind_of_code[str(item[2])]] = cell_of("items", item[:2])
         if sorted(by_kind) != list(range(len(items))):
-            raise fail("items", f"codes must be the first {len(items)} kinds in order {tuple(module.KIND_OF_CODE)}")
+            raise fail("items", f"codes must be the first {len(items)} kinds in order {declared.item_codes}")
         objects = tuple(by_kind[kind] for kind in range(len(items)))
         difficulty = len(items)
     else:
@@ -130,8 +124,8 @@ def from_paper_json(path: str | os.PathLike, scenario: str, index: int = 0, spli
     # The released Two-colour generator could spawn the agent in the totem's
     # cell (35 of its files do): a scenario that plays such files as released
     # says so; elsewhere a shared cell is a broken file.
-    if spawn in objects and not getattr(module, "IMPORTED_SPAWN_MAY_SHARE_A_CELL", False):
-        raise fail("start" if scenario != "k_item" else "spawn", "the spawn shares a cell with an object")
+    if spawn in objects and not declared.imported_spawn_may_share_a_cell:
+        raise fail("start" if declared.item_codes is None else "spawn", "the spawn shares a cell with an object")
     h_walls.flags.writeable = False
     v_walls.flags.writeable = False
     return configs.MazeConfig(

@@ -74,7 +74,7 @@ class PlaySession:
     def end_episode(self) -> None:
         """Records the current episode's result and starts the next."""
         info = self.env.task.get_info(self.env.physics)
-        field, scale, units = suite.PAPER_METRIC[self.scenario]
+        field, scale, units = suite.paper_metric(self.scenario)
         self.episodes.append({
             "config_index": info["config_index"], "steps": info["step"], "return": self.episode_return,
             "metric": float(info[field]) * scale, "metric_units": units, "finished": bool(self.timestep.last()),
@@ -83,7 +83,7 @@ class PlaySession:
 
     def screen(self) -> np.ndarray:
         info = self.env.task.get_info(self.env.physics)
-        field, scale, units = suite.PAPER_METRIC[self.scenario]
+        field, scale, units = suite.paper_metric(self.scenario)
         top = self.top_down.draw(path=np.array(self.poses), agent_pose=self.poses[-1])
         lines = [
             f"{self.scenario} {self.task_kwargs}  configuration {info['config_index']}  episode {len(self.episodes) + 1}",

@@ -1,31 +1,54 @@
-"""``load`` and the table of tasks, the way ``dm_control.suite`` does it."""
+"""``load`` and the registry of scenarios, the way ``dm_control.suite`` does it.
+
+Every module of :mod:`mjmaze.tasks` that declares a ``SCENARIO``
+(:class:`mjmaze.registry.Scenario`) is collected and registered here, with its
+gymnasium id; a scenario defined elsewhere joins with :func:`register`.
+"""
 
 from __future__ import annotations
 
 import argparse
+import importlib
 import inspect
+import pkgutil
 
+import gymnasium
 from dm_control.rl import control
 
-from mjmaze.tasks import base, find_return, k_item, labyrinth, two_colour
+from mjmaze import registry, tasks
+from mjmaze.tasks import base
 
-# name -> task class; every task is built by mjmaze.tasks.base.make_environment.
-_TASKS = {
-    "labyrinth": labyrinth.Labyrinth,
-    "find_return": find_return.FindReturn,
-    "k_item": k_item.KItem,
-    "two_colour": two_colour.TwoColour,
-}
-ALL_TASKS = tuple(_TASKS)
 
-# Each scenario's headline metric in the units of the paper's Table 2:
-# (field of info, scale, units).
-PAPER_METRIC = {
-    "labyrinth": ("success", 100.0, "success %"),
-    "find_return": ("success", 100.0, "success %"),
-    "k_item": ("item_score", 1.0, "items in order / K"),
-    "two_colour": ("duration", 1.0, "tics survived"),
-}
+def register(scenario: registry.Scenario) -> registry.Scenario:
+    """Registers a scenario: ``load``, ``gymnasium.make`` (and its vector env) and the tools then know it."""
+    registry.register(scenario)
+    if scenario.gym_id not in gymnasium.registry:
+        gymnasium.register(
+            id=scenario.gym_id,
+            entry_point="mjmaze.gym_env:MazeEnv",
+            vector_entry_point="mjmaze.vector:MazeVectorEnv",
+            kwargs={"scenario": scenario.name},
+        )
+    return scenario
+
+
+def _collect() -> tuple[str, ...]:
+    """Registers the ``SCENARIO`` of every module in :mod:`mjmaze.tasks`, in name order."""
+    for module_info in sorted(pkgutil.iter_modules(tasks.__path__), key=lambda m: m.name):
+        module = importlib.import_module(f"{tasks.__name__}.{module_info.name}")
+        if isinstance(getattr(module, "SCENARIO", None), registry.Scenario):
+            register(module.SCENARIO)
+    return registry.names()
+
+
+#: The scenarios that ship with mjmaze (the paper's four), in the paper's order.
+ALL_TASKS = tuple(sorted(_collect(), key=lambda name: registry.get(name).seed_code))
+
+
+def paper_metric(name: str) -> tuple[str, float, str]:
+    """Scenario ``name``'s headline metric: ``(info field, scale to the paper's units, units)``."""
+    scenario = registry.get(name)
+    return scenario.metric, scenario.metric_scale, scenario.metric_units
 
 
 def _parameters(function, skip=("self", "kwargs", "difficulty", "layout")) -> tuple[str, ...]:
@@ -34,7 +57,7 @@ def _parameters(function, skip=("self", "kwargs", "difficulty", "layout")) -> tu
 
 def task_kwarg_names(name: str) -> tuple[str, ...]:
     """The task arguments scenario ``name`` accepts."""
-    return _parameters(_TASKS[_check_name(name)].__init__) + _parameters(base.MazeTask.__init__)
+    return _parameters(registry.get(name).task.__init__) + _parameters(base.MazeTask.__init__)
 
 
 def make_task(name: str, task_kwargs: dict | None = None) -> base.MazeTask:
@@ -44,14 +67,14 @@ def make_task(name: str, task_kwargs: dict | None = None) -> base.MazeTask:
     unknown = sorted(set(task_kwargs) - set(valid))
     if unknown:
         raise ValueError(f"unknown task argument(s) {unknown} for {name!r}; valid: {valid}")
-    return _TASKS[name](**task_kwargs)
+    return registry.get(name).task(**task_kwargs)
 
 
 def load(name: str, task_kwargs: dict | None = None, environment_kwargs: dict | None = None) -> control.Environment:
     """Returns the dm_control environment of scenario ``name``.
 
     Args:
-      name: one of :data:`ALL_TASKS`.
+      name: a registered scenario (:func:`mjmaze.registry.names`; the paper's four are :data:`ALL_TASKS`).
       task_kwargs: the scenario's arguments (e.g. ``{"size": 9, "split": "test"}``);
         see :func:`task_kwarg_names`.
       environment_kwargs: passed on to ``dm_control.rl.control.Environment``.
@@ -63,22 +86,24 @@ def load(name: str, task_kwargs: dict | None = None, environment_kwargs: dict | 
 
 
 def difficulty_arguments(parser: argparse.ArgumentParser) -> None:
-    """Adds the command-line flags that choose a scenario (default: labyrinth) and its difficulty."""
-    parser.add_argument("--scenario", default=None, choices=ALL_TASKS, help="default: labyrinth")
-    parser.add_argument("--size", type=int, default=None, help="maze size n (Labyrinth, Find-and-return, K-item)")
-    parser.add_argument("--num-items", type=int, default=None, help="K (Ordered K-item)")
-    parser.add_argument("--complexity", type=int, default=None, help="c (Two-colour)")
+    """Adds the command-line flags that choose a scenario (default: labyrinth) and its difficulty.
+
+    One flag per difficulty argument of the registered scenarios (``--size``,
+    ``--num-items``, ``--complexity``), each naming the scenarios it sets.
+    """
+    parser.add_argument("--scenario", default=None, choices=registry.names(), help="default: labyrinth")
+    for name, scenarios in _difficulty_names().items():
+        parser.add_argument(f"--{name.replace('_', '-')}", type=int, default=None, help=f"{name} ({', '.join(scenarios)})")
 
 
 def difficulty_kwargs(args: argparse.Namespace) -> dict:
     """The task arguments of the flags added by :func:`difficulty_arguments` that were given."""
-    return {
-        key: value for key, value in (("size", args.size), ("num_items", args.num_items), ("complexity", args.complexity))
-        if value is not None
-    }
+    return {name: getattr(args, name) for name in _difficulty_names() if getattr(args, name, None) is not None}
 
 
-def _check_name(name: str) -> str:
-    if name not in _TASKS:
-        raise ValueError(f"unknown scenario {name!r}; valid: {ALL_TASKS}")
-    return name
+def _difficulty_names() -> dict[str, list[str]]:
+    """Difficulty argument -> the scenarios it is the difficulty of."""
+    names: dict[str, list[str]] = {}
+    for scenario in registry.all_scenarios():
+        names.setdefault(scenario.difficulty, []).append(scenario.name)
+    return names

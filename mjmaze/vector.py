@@ -44,7 +44,7 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode
 from gymnasium.vector.utils import batch_space
 
-from mjmaze import suite
+from mjmaze import registry, suite
 
 SHARED_MEMORY_PREFIX = "mjmaze_"
 AUTORESET_MODES = {"next_step": AutoresetMode.NEXT_STEP, "same_step": AutoresetMode.SAME_STEP}
@@ -94,21 +94,27 @@ def _write_info(columns: dict[str, np.ndarray], slot: int, info: dict) -> None:
 
 
 def _worker(worker_id, conn, shm_name, layout, env_ids, first_configs, scenario, task_kwargs, same_step):
-    """A worker's loop: build its envs, then answer step / reset / close commands."""
+    """A worker's loop: build its envs, then answer step / reset / close commands.
+
+    ``scenario`` is the declaration (:class:`mjmaze.registry.Scenario`), not a
+    name: a scenario registered at run time in the parent exists in a spawned
+    worker only once it is registered there.
+    """
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
     segment = _attach(shm_name)
     arrays = _views(layout, segment.buf)
     scalars = arrays["scalars"]
     columns = {name: scalars[name] for name in scalars.dtype.names}
     final_columns = {name: arrays["final_scalars"][name] for name in scalars.dtype.names} if same_step else None
+    busy = arrays["busy_seconds"]
     envs = []
     try:
+        suite.register(scenario)
         for slot, first in zip(env_ids, first_configs):
-            env = suite.load(scenario, {**task_kwargs, "first_config": first})
+            env = suite.load(scenario.name, {**task_kwargs, "first_config": first})
             env.task.observation_buffer = arrays["obs"][slot]
             envs.append((slot, env))
         conn.send(None)
-        busy = arrays["busy_seconds"]
         clock = time.perf_counter
         while True:
             command, argument = conn.recv()
@@ -137,6 +143,8 @@ def _worker(worker_id, conn, shm_name, layout, env_ids, first_configs, scenario,
                     _write_info(columns, slot, env.task.get_info(env.physics))
             elif command == "close":
                 break
+            else:
+                raise ValueError(f"unknown command {command!r}")
             if command == "step":
                 busy[worker_id] += clock() - started
             conn.send(None)
@@ -159,7 +167,7 @@ class MazeVectorEnv(gym.vector.VectorEnv):
 
     Args:
       num_envs: how many envs.
-      scenario: one of ``mjmaze.ALL_TASKS``.
+      scenario: a registered scenario's name (``mjmaze.registry.names()``).
       num_workers: worker processes (default: the usable cores, at most ``num_envs``).
       autoreset_mode: ``"next_step"`` (default) or ``"same_step"`` (see the module docstring).
       copy: return a copy of the shared observations (default). ``False`` returns the
@@ -245,7 +253,7 @@ class MazeVectorEnv(gym.vector.VectorEnv):
             process = ctx.Process(
                 target=_worker,
                 name=f"mjmaze-worker-{worker_id}",
-                args=(worker_id, child_end, self._shm.name, layout, env_ids, offsets, scenario, task_kwargs,
+                args=(worker_id, child_end, self._shm.name, layout, env_ids, offsets, registry.get(scenario), task_kwargs,
                       mode == AutoresetMode.SAME_STEP),
                 daemon=True,
             )

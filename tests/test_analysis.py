@@ -68,8 +68,10 @@ def test_hidden_state_analysis_of_a_random_policy_on_two_colour(tmp_path):
     assert states["hidden"].shape == (recorded, 128) == (summary["states"], 128)
     assert np.abs(states["hidden"]).max() > 0
     assert len(np.load(out / "tsne.npz")["embedding"]) == recorded == summary["tsne_points"]
-    assert {e["totem_green"] for e in summary["episodes"]} <= {True, False}
     assert states["totem_green"].shape == (recorded,)
+    for k, episode in enumerate(summary["episodes"]):  # each step carries its episode's totem colour
+        assert isinstance(episode["totem_green"], bool)
+        assert (states["totem_green"][states["episode"] == k] == episode["totem_green"]).all()
     assert summary["landmark"] == "totem"
     seen = [e["landmark_first_seen"] for e in summary["episodes"]]
     assert list(states["landmark_first_seen"]) == [-1 if s is None else s for s in seen]

@@ -25,63 +25,6 @@ def test_all_tasks_lists_every_scenario_with_a_gym_id():
         assert env_id in gymnasium.registry
 
 
-def test_dm_control_specs(task_name):
-    env = mjmaze.load(task_name)
-    assert isinstance(env, control.Environment)
-    assert env.action_spec() == specs.DiscreteArray(5, name="action")
-    pixels = env.observation_spec()["pixels"]
-    assert (pixels.shape, pixels.dtype) == ((64, 112, 3), np.uint8)
-    timestep = env.reset()
-    assert timestep.first()
-    pixels.validate(timestep.observation["pixels"])
-    env.task.close()
-
-
-def test_extended_action_set(task_name):
-    env = mjmaze.load(task_name, task_kwargs={"action_set": "extended"})
-    assert env.action_spec().num_values == 8
-    env.reset()
-    assert env.step(7).mid()
-    env.task.close()
-
-
-def test_observation_size_is_configurable(task_name):
-    env = mjmaze.load(task_name, task_kwargs={"width": 64, "height": 48})
-    assert env.reset().observation["pixels"].shape == (48, 64, 3)
-    env.task.close()
-
-
-def test_observations_are_fresh_arrays(task_name):
-    # Like dm_control's suite_test: a returned observation is never overwritten later.
-    env = mjmaze.load(task_name, task_kwargs={"random": 0})
-    first = env.reset().observation["pixels"]
-    kept = first.copy()
-    second = env.step(0).observation["pixels"]
-    assert not np.shares_memory(first, second)
-    assert np.array_equal(first, kept)
-    env.task.close()
-
-
-def test_different_starts_after_reset(task_name):
-    env = mjmaze.load(task_name, task_kwargs={"random": 0})
-    starts = {env.reset().observation["pixels"].tobytes() for _ in range(4)}
-    assert len(starts) == 4
-    env.task.close()
-
-
-def test_gymnasium_spaces_and_info(task_name):
-    env = gymnasium.make(mjmaze.GYM_IDS[task_name], render_mode="rgb_array")
-    assert env.action_space == gymnasium.spaces.Discrete(5)
-    assert env.observation_space == gymnasium.spaces.Box(0, 255, (64, 112, 3), np.uint8)
-    obs, info = env.reset(seed=1)
-    assert {"x", "y", "yaw"} <= set(info)
-    obs, reward, terminated, truncated, info = env.step(2)
-    assert obs.shape == (64, 112, 3) and isinstance(reward, float)
-    assert {"x", "y", "yaw"} <= set(info)
-    assert np.array_equal(env.render(), obs)
-    env.close()
-
-
 def test_gymnasium_reset_seed_is_reproducible():
     env = gymnasium.make("mjmaze/Labyrinth-v0", size=7, config_sampling="random")
     runs = []

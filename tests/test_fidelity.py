@@ -67,7 +67,7 @@ def test_a_wall_is_darker_far_away_than_near():
 def test_views_ninety_degrees_apart_differ_at_a_symmetric_spot(style, distinct):
     # The centre of the empty arena, totem hidden: four views the flat look draws alike.
     env = load("two_colour", complexity=0, item_cap=0, visual_style=style)
-    env.physics.show_objects(env.task._totem_geom, False)
+    env.physics.show_objects(env.physics.object_ids([two_colour.TOTEM.name])[1], False)
     frames = []
     for yaw in (0.0, math.pi / 2, math.pi, -math.pi / 2):
         place(env, 0.0, 0.0, yaw)
@@ -117,7 +117,7 @@ def test_a_two_colour_item_passed_mid_step_is_picked_up():
     task = env.task
     task.item_xy[:] = (4.5, 4.5)  # every item out of the way but one
     task.item_xy[0] = (-2.0, -3.0)
-    env.physics.place_objects(task._item_mocap, task.item_xy)
+    env.physics.place_objects(env.physics.object_ids([item.name for item in two_colour.ITEMS])[0], task.item_xy)
     beside(env, task.item_xy[0])
     env.step(FORWARD)
     assert not task.item_active[0]

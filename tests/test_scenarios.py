@@ -124,9 +124,10 @@ def test_item_colours_come_out_distinct_in_rendered_pixels():
     for kind, xy in enumerate(item_positions(env)):
         place(env, xy[0] - 0.45, xy[1], 0.0)
         shown = env.task.get_observation(env.physics)["pixels"].astype(float)
-        env.physics.show_objects(env.task._geom_ids[kind], False)
+        _, geom = env.physics.object_ids([k_item.KINDS[kind][1].name])
+        env.physics.show_objects(geom, False)
         hidden = env.task.get_observation(env.physics)["pixels"].astype(float)
-        env.physics.show_objects(env.task._geom_ids[kind], True)
+        env.physics.show_objects(geom, True)
         mask = np.abs(shown - hidden).sum(axis=-1) > 0
         assert mask.sum() > 30, f"item kind {kind} barely visible"
         means.append(shown[mask].mean(axis=0))
@@ -147,7 +148,8 @@ def test_totem_colour_is_drawn_per_episode_and_shown():
         env.reset()
         colours.append(env.task.totem_green)
     assert 10 < sum(colours) < 30
-    totem_rgba = env.physics.model.geom_rgba[env.task._totem_geom]
+    _, (totem,) = env.physics.object_ids([two_colour.TOTEM.name])
+    totem_rgba = env.physics.model.geom_rgba[totem]
     assert tuple(totem_rgba) == pytest.approx(two_colour.GREEN if colours[-1] else two_colour.RED)
 
 
@@ -274,7 +276,8 @@ def test_items_do_not_block_movement():
     env = load("two_colour", complexity=0)
     task = env.task
     task.item_xy[0] = (-0.8, 0.5)
-    env.physics.place_objects(task._item_mocap[0], task.item_xy[0])
+    (item,), _ = env.physics.object_ids([two_colour.ITEMS[0].name])
+    env.physics.place_objects(item, task.item_xy[0])
     place(env, -1.4, 0.5, 0.0)
     for _ in range(4):
         env.step(FORWARD)

@@ -35,7 +35,6 @@ from mjmaze.vector import MazeVectorEnv
 from train import checkpoint
 from train.model import Agent
 
-PAPER_METRIC = suite.PAPER_METRIC  # (info field, scale, units) per scenario
 
 
 @dataclasses.dataclass
@@ -193,7 +192,7 @@ def _loop(args, envs, agent, optimizer, device, run_dir, step, update) -> pathli
     from tqdm import tqdm
 
     n, T = args.num_envs, args.num_steps
-    metric, scale, _ = PAPER_METRIC[args.scenario]
+    metric, scale, _ = suite.paper_metric(args.scenario)
     frame_shape = envs.single_observation_space.shape
     frames = torch.zeros((T, n, *frame_shape), dtype=torch.uint8)
     starts = torch.zeros((T, n), dtype=torch.bool)

@@ -32,9 +32,8 @@ import numpy as np
 from matplotlib.figure import Figure
 
 import mjmaze
-from mjmaze import files
+from mjmaze import files, registry, suite
 from train import checkpoint, policy
-from train.a2c import PAPER_METRIC
 
 TSNE_STATES = 2000
 TSNE_LINES = 20
@@ -67,7 +66,7 @@ def heatmap(episode: policy.Episode, scenario: str, title: str) -> Figure:
     seen = episode.landmark_first_seen
     if seen is not None and seen < episode.length:
         axes.axvline(seen, color="k", linestyle="--", linewidth=1.5,
-                     label=f"{policy.LANDMARK[scenario]} first in view (step {seen})")
+                     label=f"{registry.get(scenario).landmark} first in view (step {seen})")
         axes.legend(loc="upper right", fontsize=8, framealpha=0.9)
     axes.set_xlabel("step")
     axes.set_ylabel("hidden unit")
@@ -131,7 +130,7 @@ def analyse(source_args: argparse.Namespace, episodes: int, out: pathlib.Path | 
     poses = np.concatenate([e.poses[:-1] for e in played])
     first_seen = np.array([-1 if e.landmark_first_seen is None else e.landmark_first_seen for e in played])
     totem_green = None
-    if scenario == "two_colour":
+    if "totem_green" in played[0].infos[0]:  # a totem whose colour is the cue (Two-colour)
         totem_green = np.concatenate([np.full(e.length, bool(e.infos[0]["totem_green"])) for e in played])
 
     buffer = io.BytesIO()
@@ -154,15 +153,15 @@ def analyse(source_args: argparse.Namespace, episodes: int, out: pathlib.Path | 
     save_figure(tsne_figure(embedding, steps[chosen], episode_of[chosen], title,
                             None if totem_green is None else totem_green[chosen]), out / "tsne.png")
 
-    field, scale, units = PAPER_METRIC[scenario]
+    field, scale, units = suite.paper_metric(scenario)
     summary = {
         "source": source_args.source, "description": description, "scenario": scenario, "task_kwargs": task_kwargs,
         "split": source_args.split, "states": len(hidden), "tsne_points": len(embedding),
-        "landmark": policy.LANDMARK[scenario], "metric_units": units, "heatmap_episode": heatmap_episode,
+        "landmark": registry.get(scenario).landmark, "metric_units": units, "heatmap_episode": heatmap_episode,
         "episodes": [
             {"config_index": e.config_index, "length": e.length, "return": float(e.rewards.sum()),
              "metric": float(e.infos[-1][field]) * scale, "landmark_first_seen": e.landmark_first_seen,
-             **({"totem_green": bool(e.infos[0]["totem_green"])} if scenario == "two_colour" else {})}
+             **({"totem_green": bool(e.infos[0]["totem_green"])} if "totem_green" in e.infos[0] else {})}
             for e in played
         ],
         "files": [str(out / name) for name in ("states.npz", "heatmap.png", "tsne.png", "tsne.npz", "summary.json")],

@@ -21,9 +21,8 @@ import pathlib
 import numpy as np
 from matplotlib.figure import Figure
 
-from mjmaze import files
+from mjmaze import files, suite
 from train import checkpoint, evaluate
-from train.a2c import PAPER_METRIC
 from train.analysis import save_figure
 
 BINS = 40
@@ -35,7 +34,7 @@ def read_run(run_dir: pathlib.Path) -> dict:
     if not config_file.exists():
         raise FileNotFoundError(f"{run_dir} is not a training run (no config.json)")
     config = json.loads(config_file.read_text())
-    field = PAPER_METRIC[config["scenario"]][0]
+    field = suite.paper_metric(config["scenario"])[0]
     steps, values = [], []
     metrics_file = run_dir / "metrics.jsonl"
     if metrics_file.exists():
@@ -124,7 +123,7 @@ def curves(run_dirs: list[pathlib.Path], bins: int = BINS) -> list[dict]:
     for runs in groups.values():
         config = runs[0]["config"]
         result.append({
-            "label": label(config), "scenario": config["scenario"], "units": PAPER_METRIC[config["scenario"]][2],
+            "label": label(config), "scenario": config["scenario"], "units": suite.paper_metric(config["scenario"])[2],
             "runs": [r["dir"] for r in runs], "training": binned(runs, bins), "evaluations": evaluations(runs),
         })
     return result
@@ -156,7 +155,7 @@ def figure(groups: list[dict], title: str = "") -> Figure:
     for ax, scenario in zip(axes, scenarios):
         ax.set_title(scenario, fontsize=10)
         ax.set_xlabel("agent steps")
-        ax.set_ylabel(PAPER_METRIC[scenario][2])
+        ax.set_ylabel(suite.paper_metric(scenario)[2])
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="best")
     if title:

@@ -18,10 +18,10 @@ import pathlib
 import numpy as np
 import torch
 
-from mjmaze import files
+from mjmaze import files, suite
 from mjmaze.vector import MazeVectorEnv
 from train import checkpoint, policy
-from train.a2c import PAPER_METRIC, Args, pick_device
+from train.a2c import Args, pick_device
 from train.model import Agent
 
 EVAL_CONFIGS = 64
@@ -43,7 +43,7 @@ def play_split(agent: Agent, args: Args, split: str, num_envs: int, device: torc
         num_envs, args.scenario, autoreset_mode="same_step", copy=False, split=split,
         num_configs=num_configs, config_sampling="cycle", **task_kwargs,
     )
-    metric, scale, _ = PAPER_METRIC[args.scenario]
+    metric, scale, _ = suite.paper_metric(args.scenario)
     episodes: list[list[dict]] = [[] for _ in range(num_envs)]
     try:
         obs, _ = envs.reset(seed=seed)
@@ -88,7 +88,7 @@ def evaluate(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | 
         "step": int(state["step"]),
         "scenario": args.scenario,
         "task_kwargs": args.task_kwargs(),
-        "units": PAPER_METRIC[args.scenario][2],
+        "units": suite.paper_metric(args.scenario)[2],
     }
     for split in ("train", "test"):
         result[split] = play_split(agent, args, split, num_envs, torch_device, num_configs=num_configs)

@@ -20,13 +20,10 @@ import torch
 
 from mjmaze import suite, viz
 from train import checkpoint
-from train.a2c import PAPER_METRIC, Args
+from train.a2c import Args
 from train.model import Agent
 
 RANDOM = "random"
-# The object whose first sighting analysis marks: Two-colour's totem, Labyrinth's
-# exit, Find-and-return's red pillar, K-item's first item (all object cell 0).
-LANDMARK = {"labyrinth": "exit", "find_return": "red pillar", "k_item": "first item", "two_colour": "totem"}
 
 
 def load_run(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | None = None,
@@ -199,5 +196,5 @@ def policy_from_arguments(args: argparse.Namespace) -> tuple[str, dict, Policy, 
 
 def metric_of(scenario: str, info: dict) -> str:
     """The scenario's headline metric in the paper's units, as text."""
-    field, scale, label = PAPER_METRIC[scenario]
+    field, scale, label = suite.paper_metric(scenario)
     return f"{label}: {float(info[field]) * scale:.3g}"

@@ -21,9 +21,8 @@ import imageio.v2 as imageio
 import numpy as np
 
 import mjmaze
-from mjmaze import files, viz
+from mjmaze import files, suite, viz
 from train import checkpoint, policy
-from train.a2c import PAPER_METRIC
 
 FPS = 35 / 4  # real time: one frame per agent step (4 tics at 35 Hz)
 MAP_SIZE = 256
@@ -77,7 +76,7 @@ def record(source_args: argparse.Namespace, episodes: int, out: pathlib.Path, fp
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.stem}.tmp{path.suffix}")
     header = f"{description} | {scenario} {task_kwargs} | {source_args.split}"
-    field, scale, units = PAPER_METRIC[scenario]
+    field, scale, units = suite.paper_metric(scenario)
     summary = {"video": str(path), "source": source_args.source, "scenario": scenario, "task_kwargs": task_kwargs,
                "split": source_args.split, "fps": fps, "frames": 0, "metric_units": units, "episodes": []}
     try:

@@ -27,22 +27,10 @@ import pathlib
 
 import numpy as np
 
-from mjmaze import files
+from mjmaze import files, registry, suite
 from train import curves
-from train.a2c import PAPER_METRIC
-from train.sweep import DIFFICULTY
 
-# The paper's Table 2: (scenario, difficulty) -> (train mean, train std, test mean, test std).
-PAPER_TABLE2 = {
-    ("labyrinth", 7): (99.8, 0.2, 99.5, 0.2), ("labyrinth", 9): (98.1, 0.8, 97.4, 1.3),
-    ("labyrinth", 11): (95.2, 0.7, 90.1, 1.0), ("labyrinth", 13): (84.1, 1.8, 79.8, 1.9),
-    ("find_return", 7): (98.7, 0.3, 95.1, 0.2), ("find_return", 9): (87.0, 1.9, 81.6, 1.8),
-    ("find_return", 11): (70.9, 1.6, 64.0, 1.6), ("find_return", 13): (57.7, 0.8, 52.9, 3.7),
-    ("k_item", 2): (0.968, 0.004, 0.932, 0.012), ("k_item", 4): (0.910, 0.012, 0.861, 0.015),
-    ("k_item", 6): (0.577, 0.024, 0.522, 0.023), ("k_item", 8): (0.084, 0.071, 0.083, 0.070),
-    ("two_colour", 1): (1903, 27, 1941, 4), ("two_colour", 3): (1789, 24, 1781, 24),
-    ("two_colour", 5): (1436, 158, 1432, 161), ("two_colour", 7): (1159, 126, 1128, 140),
-}
+# The paper's Table 2 is each scenario's ``paper_results`` in mjmaze.registry.
 PAPER_STEPS = 200_000_000
 CSV_FIELDS = ("scenario", "difficulty_name", "difficulty", "num_configs", "units", "seeds", "evaluated", "steps",
               "episodes",
@@ -61,17 +49,17 @@ def collect(sweep_dir: pathlib.Path) -> tuple[list[dict], list[pathlib.Path]]:
         eval_file = run_dir / "eval.json"
         result = json.loads(eval_file.read_text()) if eval_file.exists() else None
         scenario = config["scenario"]
-        key = (scenario, config.get(DIFFICULTY[scenario]), config.get("num_configs"))
+        key = (scenario, config.get(registry.get(scenario).difficulty), config.get("num_configs"))
         groups.setdefault(key, []).append((config, result))
     rows = []
     for (scenario, difficulty, num_configs), runs in sorted(groups.items(), key=lambda kv: _order(kv[0])):
         evaluated = [r for _, r in runs if r is not None]
         train = np.array([r["train"]["value"] for r in evaluated])
         test = np.array([r["test"]["value"] for r in evaluated])
-        paper = PAPER_TABLE2.get((scenario, difficulty)) if num_configs is None else None
+        paper = registry.get(scenario).paper_results.get(difficulty) if num_configs is None else None
         rows.append({
-            "scenario": scenario, "difficulty_name": DIFFICULTY[scenario], "difficulty": difficulty,
-            "num_configs": num_configs, "units": PAPER_METRIC[scenario][2], "seeds": len(runs),
+            "scenario": scenario, "difficulty_name": registry.get(scenario).difficulty, "difficulty": difficulty,
+            "num_configs": num_configs, "units": suite.paper_metric(scenario)[2], "seeds": len(runs),
             "evaluated": len(evaluated), "steps": min((r["step"] for r in evaluated), default=None),
             "episodes": min((r["test"]["episodes"] for r in evaluated), default=None),
             "train_mean": float(train.mean()) if len(train) else None,
@@ -86,13 +74,13 @@ def collect(sweep_dir: pathlib.Path) -> tuple[list[dict], list[pathlib.Path]]:
 
 def _order(key: tuple) -> tuple:
     scenario, difficulty, num_configs = key
-    return (list(DIFFICULTY).index(scenario), difficulty or 0, num_configs or 0)
+    return (registry.get(scenario).seed_code, difficulty or 0, num_configs or 0)
 
 
 def _cell(mean, std, scenario: str) -> str:
     if mean is None:
         return "-"
-    digits = 3 if scenario == "k_item" else (0 if scenario == "two_colour" else 1)
+    digits = registry.get(scenario).metric_digits
     return f"{mean:.{digits}f} ± {std:.{digits}f}"
 
 
@@ -103,11 +91,11 @@ def markdown(rows: list[dict], sweep_dir: pathlib.Path) -> str:
              f"{PAPER_STEPS // 1_000_000}M steps, 3 seeds).")
     lines = [f"# Results of `{sweep_dir}`", "", intro, ""]
     for scenario in dict.fromkeys(r["scenario"] for r in rows):
-        units = PAPER_METRIC[scenario][2]
+        units = suite.paper_metric(scenario)[2]
         scenario_rows = [r for r in rows if r["scenario"] == scenario]
         with_configs = any(r["num_configs"] for r in scenario_rows)
         lines += [f"## {scenario} ({units})", ""]
-        header = [DIFFICULTY[scenario], *(["training mazes"] if with_configs else []), "seeds", "steps",
+        header = [registry.get(scenario).difficulty, *(["training mazes"] if with_configs else []), "seeds", "steps",
                   "train", "test", "paper train", "paper test"]
         lines += ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
         for r in scenario_rows:

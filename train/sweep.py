@@ -30,13 +30,9 @@ import pathlib
 import sys
 import time
 
-from mjmaze import files, suite
+from mjmaze import files, registry, suite
 from train import a2c, checkpoint, evaluate
 
-# The task argument that sets each scenario's difficulty in the paper's Table 2.
-DIFFICULTY = {"labyrinth": "size", "find_return": "size", "k_item": "num_items", "two_colour": "complexity"}
-PAPER_DIFFICULTIES = {"labyrinth": (7, 9, 11, 13), "find_return": (7, 9, 11, 13), "k_item": (2, 4, 6, 8),
-                      "two_colour": (1, 3, 5, 7)}
 GENERALISATION_CONFIGS = (16, 64, 256, 1024)
 # The generalisation study's maze size: the paper does not state it; Labyrinth's default.
 GENERALISATION_SIZE = 9
@@ -56,12 +52,12 @@ class RunSpec:
     @property
     def name(self) -> str:
         configs = f"_n{self.num_configs}" if self.num_configs else ""
-        return f"{self.scenario}_{DIFFICULTY[self.scenario]}{self.difficulty}{configs}_s{self.seed}"
+        return f"{self.scenario}_{registry.get(self.scenario).difficulty}{self.difficulty}{configs}_s{self.seed}"
 
     def args(self, settings: dict, runs_dir: pathlib.Path) -> a2c.Args:
         """The training flags of this run: ``settings`` (shared by the sweep) plus its own."""
         return a2c.Args(**{
-            **settings, "scenario": self.scenario, DIFFICULTY[self.scenario]: self.difficulty, "seed": self.seed,
+            **settings, "scenario": self.scenario, registry.get(self.scenario).difficulty: self.difficulty, "seed": self.seed,
             "num_configs": self.num_configs, "runs_dir": str(runs_dir), "run_name": self.name, "progress": False,
         })
 
@@ -71,7 +67,12 @@ def grid(name: str, seeds: list[int] | None = None, scenario: str | None = None,
     """The runs of grid ``name``; ``seeds`` overrides the grid's, the rest define ``custom``."""
     if name == "paper":
         seeds = seeds or [0, 1, 2]
-        return [RunSpec(s, d, seed) for s, ds in PAPER_DIFFICULTIES.items() for d in ds for seed in seeds]
+        return [
+            RunSpec(scenario, d, seed)
+            for scenario in suite.ALL_TASKS
+            for d in registry.get(scenario).paper_difficulties
+            for seed in seeds
+        ]
     if name == "generalisation":
         seeds = seeds or [0, 1, 2]
         return [RunSpec("labyrinth", GENERALISATION_SIZE, seed, n) for n in GENERALISATION_CONFIGS for seed in seeds]
@@ -79,8 +80,8 @@ def grid(name: str, seeds: list[int] | None = None, scenario: str | None = None,
         seeds = seeds or [0, 1]
         return [RunSpec("labyrinth", d, seed) for d in (5, 7) for seed in seeds]
     if name == "custom":
-        if scenario not in DIFFICULTY or not difficulties:
-            raise ValueError(f"--grid custom needs --scenario (one of {tuple(DIFFICULTY)}) and --difficulties")
+        if scenario not in registry.names() or not difficulties:
+            raise ValueError(f"--grid custom needs --scenario (one of {registry.names()}) and --difficulties")
         seeds = seeds or [0]
         return [RunSpec(scenario, d, seed, n) for d in difficulties for n in (num_configs or [None]) for seed in seeds]
     raise ValueError(f"unknown grid {name!r}; choose one of {GRIDS}")

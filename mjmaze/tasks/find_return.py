@@ -20,10 +20,11 @@ Metric
 
 from __future__ import annotations
 
-from mjmaze import configs, maze, mjcf
+from mjmaze import configs, maze, mjcf, registry
 from mjmaze.tasks import base
 
 SIZES = (5, 7, 9, 11, 13)
+PAPER_SIZES = (7, 9, 11, 13)
 DEFAULT_SIZE = 9
 CELL_SIZE = 1.0
 TARGET_REWARD = 0.5
@@ -83,3 +84,20 @@ class FindReturn(base.MazeTask):
     def metrics(self) -> dict:
         return {"success": self._success, "target_found": self._target_found}
 
+
+SCENARIO = registry.Scenario(
+    name="find_return",
+    task=FindReturn,
+    gym_id="mjmaze/FindReturn-v0",
+    seed_code=2,
+    difficulty="size",
+    difficulties=SIZES,
+    paper_difficulties=PAPER_SIZES,
+    metric="success",
+    metric_scale=100.0,
+    metric_units="success %",
+    metric_digits=1,
+    cell_size=CELL_SIZE,
+    landmark="red pillar",
+    paper_results={7: (98.7, 0.3, 95.1, 0.2), 9: (87.0, 1.9, 81.6, 1.8), 11: (70.9, 1.6, 64.0, 1.6), 13: (57.7, 0.8, 52.9, 3.7)},
+)

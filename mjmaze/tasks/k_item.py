@@ -25,7 +25,7 @@ differ in shape (:data:`KINDS`).
 from __future__ import annotations
 
 import numpy as np
-from mjmaze import configs, maze, mjcf
+from mjmaze import configs, maze, mjcf, registry
 from mjmaze.tasks import base
 
 NUM_ITEMS = tuple(range(1, 9))
@@ -96,3 +96,24 @@ class KItem(base.MazeTask):
     def metrics(self) -> dict:
         return {"items_in_order": self._next, "item_score": self._next / self.num_items}
 
+
+SCENARIO = registry.Scenario(
+    name="k_item",
+    task=KItem,
+    gym_id="mjmaze/KItem-v0",
+    seed_code=3,
+    difficulty="num_items",
+    difficulties=NUM_ITEMS,
+    paper_difficulties=PAPER_NUM_ITEMS,
+    metric="item_score",
+    metric_scale=1.0,
+    metric_units="items in order / K",
+    metric_digits=3,
+    cell_size=CELL_SIZE,
+    landmark="first item",
+    paper_results={
+        2: (0.968, 0.004, 0.932, 0.012), 4: (0.910, 0.012, 0.861, 0.015),
+        6: (0.577, 0.024, 0.522, 0.023), 8: (0.084, 0.071, 0.083, 0.070),
+    },
+    item_codes=tuple(code for code, _ in KINDS),
+)

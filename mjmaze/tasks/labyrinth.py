@@ -19,10 +19,11 @@ Metric
 
 from __future__ import annotations
 
-from mjmaze import configs, maze, mjcf
+from mjmaze import configs, maze, mjcf, registry
 from mjmaze.tasks import base
 
 SIZES = (5, 7, 9, 11, 13)
+PAPER_SIZES = (7, 9, 11, 13)
 DEFAULT_SIZE = 9
 CELL_SIZE = 1.0
 EXIT_REWARD = 1.0
@@ -60,3 +61,20 @@ class Labyrinth(base.MazeTask):
     def metrics(self) -> dict:
         return {"success": self._success}
 
+
+SCENARIO = registry.Scenario(
+    name="labyrinth",
+    task=Labyrinth,
+    gym_id="mjmaze/Labyrinth-v0",
+    seed_code=1,
+    difficulty="size",
+    difficulties=SIZES,
+    paper_difficulties=PAPER_SIZES,
+    metric="success",
+    metric_scale=100.0,
+    metric_units="success %",
+    metric_digits=1,
+    cell_size=CELL_SIZE,
+    landmark="exit",
+    paper_results={7: (99.8, 0.2, 99.5, 0.2), 9: (98.1, 0.8, 97.4, 1.3), 11: (95.2, 0.7, 90.1, 1.0), 13: (84.1, 1.8, 79.8, 1.9)},
+)

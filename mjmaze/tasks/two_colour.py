@@ -37,7 +37,7 @@ import math
 
 import numpy as np
 
-from mjmaze import configs, mjcf
+from mjmaze import configs, mjcf, registry
 from mjmaze.tasks import base
 
 COMPLEXITIES = tuple(range(0, 11))
@@ -58,8 +58,6 @@ CORRECT_ITEM_REWARD = 1.0
 ITEM_WALL_CLEARANCE = base.AGENT_RADIUS
 # Draws per item before giving up (a draw lands on free floor far more often than 1 in 10).
 _MAX_ITEM_DRAWS = 10_000
-# Imported layouts may spawn the agent in the totem's cell (see TwoColour).
-IMPORTED_SPAWN_MAY_SHARE_A_CELL = True
 
 RED, GREEN = (0.9, 0.1, 0.1, 1.0), (0.1, 0.8, 0.1, 1.0)
 TOTEM_RADIUS, TOTEM_HEIGHT = 0.125, 1.0
@@ -185,3 +183,24 @@ class TwoColour(base.MazeTask):
             "health": self.health,
             "totem_green": self.totem_green,
         }
+
+
+SCENARIO = registry.Scenario(
+    name="two_colour",
+    task=TwoColour,
+    gym_id="mjmaze/TwoColour-v0",
+    seed_code=4,
+    difficulty="complexity",
+    difficulties=COMPLEXITIES,
+    paper_difficulties=PAPER_COMPLEXITIES,
+    metric="duration",
+    metric_scale=1.0,
+    metric_units="tics survived",
+    metric_digits=0,
+    cell_size=CELL_SIZE,
+    landmark="totem",
+    paper_results={1: (1903, 27, 1941, 4), 3: (1789, 24, 1781, 24), 5: (1436, 158, 1432, 161), 7: (1159, 126, 1128, 140)},
+    # The released generator could spawn the agent in the totem's cell; such
+    # an imported layout plays as released (see TwoColour).
+    imported_spawn_may_share_a_cell=True,
+)
