@@ -2,7 +2,7 @@
 
     python -m train.evaluate runs/labyrinth_5_s0 [--checkpoint PATH] [--num-envs 16]
 
-**Decision** (as in SCENARIOS.md): each of the first 64 test configurations, and
+**Decision** (also in the README): each of the first 64 test configurations, and
 64 training ones, is played twice to its end or the time limit - 128 episodes
 per split - rather than the released "first 128 episodes to finish", which
 favoured short episodes. Actions are the argmax of the policy. Writes
