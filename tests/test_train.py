@@ -153,3 +153,62 @@ def test_sigterm_saves_a_final_checkpoint(tmp_path):
     saved = checkpoint.checkpoints(tmp_path / "term" / "checkpoints")
     assert len(saved) == 1 and checkpoint.load(saved[0])["step"] >= 32
     assert "stopped at step" in output
+
+
+def _env_workers(pid: int) -> list[int]:
+    """The env worker processes of a training process (not multiprocessing's resource tracker)."""
+    import pathlib
+
+    workers = []
+    for task in pathlib.Path(f"/proc/{pid}/task").iterdir():
+        for child in (task / "children").read_text().split():
+            cmdline = pathlib.Path(f"/proc/{child}/cmdline").read_bytes()
+            if b"multiprocessing" in cmdline and b"resource_tracker" not in cmdline:
+                workers.append(int(child))
+    return workers
+
+
+def test_a_killed_env_worker_costs_the_run_nothing_but_its_rollout(tmp_path):
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    command = [sys.executable, "-m", "train.a2c", "--size", "5", "--num-envs", "2", "--num-steps", "8",
+               "--num-workers", "2", "--total-steps", "1600", "--runs-dir", str(tmp_path), "--run-name", "kill",
+               "--no-progress", "--checkpoint-every", "1000000", "--torch-threads", "1"]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    metrics = tmp_path / "kill" / "metrics.jsonl"
+    deadline = time.monotonic() + 120
+    while not (metrics.exists() and metrics.read_text().count("\n") >= 2):
+        assert process.poll() is None and time.monotonic() < deadline, process.stdout.read()
+        time.sleep(0.05)
+    os.kill(_env_workers(process.pid)[0], signal.SIGKILL)
+    output, _ = process.communicate(timeout=240)
+    assert process.returncode == 0, output
+    assert "rebuilding the envs" in output and "Traceback" not in output
+    lines = [json.loads(line) for line in metrics.read_text().splitlines()]
+    assert lines[-1]["step"] == 1600 and lines[-1]["env_rebuilds"] == 1
+    assert checkpoint.load(checkpoint.checkpoints(tmp_path / "kill" / "checkpoints")[-1])["step"] == 1600
+
+
+def test_workers_that_keep_dying_end_in_a_checkpoint_and_one_line(tmp_path, monkeypatch):
+    from mjmaze import vector
+
+    calls = {"n": 0}
+    real_step = vector.MazeVectorEnv.step
+
+    def failing_step(self, actions):
+        calls["n"] += 1
+        if calls["n"] > 3:  # the first update completes; then every rollout fails
+            raise vector.WorkerError("env worker 0 was killed by SIGKILL")
+        return real_step(self, actions)
+
+    monkeypatch.setattr(vector.MazeVectorEnv, "step", failing_step)
+    with pytest.raises(SystemExit) as stop:
+        a2c.train(tiny(tmp_path, total_steps=1000, num_steps=2))
+    message = str(stop.value)
+    assert "failed 3 times in a row" in message and "--resume" in message and "\n" not in message
+    saved = checkpoint.checkpoints(tmp_path / "tiny" / "checkpoints")
+    assert checkpoint.load(saved[-1])["step"] == 4

@@ -20,9 +20,11 @@ at 0.5; RMSprop (lr 7e-4, alpha 0.99, eps 1e-8).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import json
 import pathlib
 import signal
+import sys
 import time
 
 import numpy as np
@@ -31,7 +33,7 @@ import tyro
 from torch.nn import functional as F
 
 from mjmaze import files, suite
-from mjmaze.vector import MazeVectorEnv
+from mjmaze.vector import MazeVectorEnv, WorkerError
 from train import checkpoint
 from train.model import Agent
 
@@ -143,6 +145,11 @@ def pick_device(name: str) -> torch.device:
     return torch.device(name)
 
 
+# Env failures in a row (no update completed in between) before training
+# stops: one dead worker is rebuilt and forgotten, a crash loop is not.
+MAX_ENV_FAILURES = 3
+
+
 class _Stop(Exception):
     """Ctrl-C or SIGTERM, turned into a clean stop."""
 
@@ -169,10 +176,11 @@ def train(args: Args) -> pathlib.Path:
     if args.torch_threads:
         torch.set_num_threads(args.torch_threads)
     torch.manual_seed(args.seed)
-    envs = MazeVectorEnv(
-        args.num_envs, args.scenario, num_workers=args.num_workers, autoreset_mode="same_step", copy=False,
-        split="train", **task_kwargs,
+    make_envs = functools.partial(
+        MazeVectorEnv, args.num_envs, args.scenario, num_workers=args.num_workers, autoreset_mode="same_step",
+        copy=False, split="train", **task_kwargs,
     )
+    envs = make_envs()
     try:
         agent = Agent(envs.single_action_space.n, envs.single_observation_space.shape).to(device)
         optimizer = torch.optim.RMSprop(agent.parameters(), lr=args.lr, alpha=args.alpha, eps=args.eps)
@@ -182,12 +190,14 @@ def train(args: Args) -> pathlib.Path:
             optimizer.load_state_dict(state["optimizer"])
             step, update = int(state["step"]), int(state["update"])
         files.atomic_write_json(run_dir / "config.json", config)
-        return _loop(args, envs, agent, optimizer, device, run_dir, step, update)
-    finally:
+    except BaseException:
         envs.close()
+        raise
+    return _loop(args, make_envs, envs, agent, optimizer, device, run_dir, step, update)
 
 
-def _loop(args, envs, agent, optimizer, device, run_dir, step, update) -> pathlib.Path:
+def _loop(args, make_envs, envs, agent, optimizer, device, run_dir, step, update) -> pathlib.Path:
+    """The training loop; it owns ``envs`` (and rebuilds them with ``make_envs`` when a worker dies)."""
     from torch.utils.tensorboard import SummaryWriter
     from tqdm import tqdm
 
@@ -210,27 +220,48 @@ def _loop(args, envs, agent, optimizer, device, run_dir, step, update) -> pathli
     # Ctrl-C and SIGTERM both end in a final checkpoint (installed explicitly:
     # a job started in the background may inherit an ignored SIGINT).
     previous_handlers = {sig: signal.signal(sig, _raise_stop) for sig in (signal.SIGINT, signal.SIGTERM)}
-    stopped = False
+    stopped, failures, rebuilds = False, 0, 0
     try:
         while step < args.total_steps:
             start_time = time.perf_counter()
             first_hidden = hidden.detach()
             finished = []  # final infos of the episodes that ended in this rollout
-            for t in range(T):
-                frames[t].copy_(torch.from_numpy(obs))
-                starts[t] = episode_starts
-                with torch.no_grad():
-                    features = agent.features(frames[t].to(device))
-                    logits, _, hidden = agent.step(features, hidden, episode_starts.to(device))
-                    action = torch.distributions.Categorical(logits=logits).sample()
-                obs, reward, terminated, truncated, infos = envs.step(action.cpu().numpy())
-                ended = terminated | truncated
-                actions[t] = action.cpu()
-                rewards[t] = torch.from_numpy(reward)
-                dones[t] = torch.from_numpy(ended.astype(np.float32))
-                episode_starts = torch.from_numpy(ended)
-                for i in np.flatnonzero(ended):
-                    finished.append({k: v[i] for k, v in infos["final_info"].items() if not k.startswith("_")})
+            try:
+                for t in range(T):
+                    frames[t].copy_(torch.from_numpy(obs))
+                    starts[t] = episode_starts
+                    with torch.no_grad():
+                        features = agent.features(frames[t].to(device))
+                        logits, _, hidden = agent.step(features, hidden, episode_starts.to(device))
+                        action = torch.distributions.Categorical(logits=logits).sample()
+                    obs, reward, terminated, truncated, infos = envs.step(action.cpu().numpy())
+                    ended = terminated | truncated
+                    actions[t] = action.cpu()
+                    rewards[t] = torch.from_numpy(reward)
+                    dones[t] = torch.from_numpy(ended.astype(np.float32))
+                    episode_starts = torch.from_numpy(ended)
+                    for i in np.flatnonzero(ended):
+                        finished.append({k: v[i] for k, v in infos["final_info"].items() if not k.startswith("_")})
+            except WorkerError as error:
+                # The network and optimizer are intact: drop this rollout (its
+                # episodes are cut), rebuild the envs and start fresh episodes.
+                envs.close()
+                failures += 1
+                if failures >= MAX_ENV_FAILURES:
+                    path = _save(args, agent, optimizer, step, update, run_dir)
+                    raise SystemExit(
+                        f"error: the env workers failed {failures} times in a row (last: {error}); "
+                        f"checkpoint {path} at step {step:,}: fix the cause, then go on with --resume"
+                    ) from None
+                print(f"step {step:,}: {error}; rebuilding the envs ({failures} of {MAX_ENV_FAILURES - 1} retries)",
+                      file=sys.stderr)
+                envs = make_envs()
+                rebuilds += 1
+                obs, _ = envs.reset(seed=args.seed + 1000 * update + rebuilds)
+                hidden = agent.initial_state(n, device)
+                episode_starts = torch.ones(n, dtype=torch.bool)
+                continue
+            failures = 0
             with torch.no_grad():
                 features = agent.features(torch.from_numpy(obs).to(device))
                 _, last_value, _ = agent.step(features, hidden, episode_starts.to(device))
@@ -250,6 +281,7 @@ def _loop(args, envs, agent, optimizer, device, run_dir, step, update) -> pathli
                 "step": step, "update": update, "sps": sps,
                 "policy_loss": losses["policy"].item(), "value_loss": losses["value"].item(),
                 "entropy": losses["entropy"].item(), "grad_norm": float(grad_norm), "episodes": len(finished),
+                "env_rebuilds": rebuilds,
             }
             if finished:
                 record["episode_return"] = float(np.mean([e["episode_return"] for e in finished]))
@@ -270,6 +302,7 @@ def _loop(args, envs, agent, optimizer, device, run_dir, step, update) -> pathli
     except (KeyboardInterrupt, _Stop):
         stopped = True
     finally:
+        envs.close()
         for sig, handler in previous_handlers.items():
             signal.signal(sig, handler)
         bar.close()
