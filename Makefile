@@ -24,9 +24,9 @@ endif
 .PHONY: run test bench setup system-deps clean
 
 run: system-deps $(VENV)/.stamp-torch $(VENV)/.stamp-train,viz
-	$(PY) -m train.a2c --scenario labyrinth --size 5 --total-steps $(RUN_STEPS) \
+	$(PY) -m mjmaze.train.a2c --scenario labyrinth --size 5 --total-steps $(RUN_STEPS) \
 	  --run-name $(RUN_NAME) --checkpoint-every 250000
-	$(PY) -m train.evaluate runs/$(RUN_NAME)
+	$(PY) -m mjmaze.train.evaluate runs/$(RUN_NAME)
 
 test: system-deps $(VENV)/.stamp-torch $(VENV)/.stamp-train,dev
 	$(PY) -m pytest -q

@@ -5,7 +5,7 @@
   env only      MazeVectorEnv, 16 envs, Labyrinth 5x5, random actions
   network only  one update's worth of network work on random frames: 128 inference
                 steps of 16 frames, then the forward + backward pass over 2048 frames
-  training      python -m train.a2c on Labyrinth 5x5 (16 envs x 128 steps), median
+  training      python -m mjmaze.train.a2c on Labyrinth 5x5 (16 envs x 128 steps), median
                 over the updates after the first two
 """
 
@@ -22,8 +22,9 @@ import numpy as np
 import torch
 
 from mjmaze.vector import MazeVectorEnv
-from train import a2c
-from train.model import Agent
+from mjmaze.train import settings as run_settings
+from mjmaze.train import a2c
+from mjmaze.train.model import Agent
 
 NUM_ENVS, NUM_STEPS = 16, 128
 
@@ -69,7 +70,7 @@ def network_only(device: torch.device, repeats: int = 3) -> float:
 
 def training(updates: int, device: str) -> float:
     with tempfile.TemporaryDirectory() as runs:
-        args = a2c.Args(scenario="labyrinth", size=5, total_steps=updates * NUM_ENVS * NUM_STEPS, runs_dir=runs,
+        args = run_settings.Args(scenario="labyrinth", size=5, total_steps=updates * NUM_ENVS * NUM_STEPS, runs_dir=runs,
                         run_name="bench", progress=False, device=device, checkpoint_every=10**12)
         run = a2c.train(args)
         sps = [json.loads(line)["sps"] for line in (pathlib.Path(run) / "metrics.jsonl").read_text().splitlines()]
@@ -81,7 +82,7 @@ def main() -> None:
     parser.add_argument("--updates", type=int, default=12)
     parser.add_argument("--device", default="auto")
     args = parser.parse_args()
-    device = a2c.pick_device(args.device)
+    device = run_settings.pick_device(args.device)
     print(f"A2C on Labyrinth 5x5, 16 envs x 128 steps, device {device}, {torch.get_num_threads()} torch threads")
     print(f"  env only      {env_only():8.0f} obs/s")
     print(f"  network only  {network_only(device):8.0f} obs/s")

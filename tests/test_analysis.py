@@ -7,7 +7,8 @@ import imageio.v3 as iio
 import numpy as np
 import pytest
 
-from train import a2c, analysis, curves, evaluate, record
+from mjmaze.train import settings as run_settings
+from mjmaze.train import a2c, analysis, curves, evaluate, record
 
 
 def tiny_run(tmp_path, name, **overrides):
@@ -16,7 +17,7 @@ def tiny_run(tmp_path, name, **overrides):
         run_name=name, checkpoint_every=16, progress=False, torch_threads=1,
     )
     settings.update(overrides)
-    return a2c.train(a2c.Args(**settings))
+    return a2c.train(run_settings.Args(**settings))
 
 
 def picture(path):

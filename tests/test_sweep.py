@@ -12,7 +12,7 @@ import pytest
 
 import mjmaze
 
-from train import report, sweep
+from mjmaze.train import report, sweep
 
 
 def test_the_paper_grid_is_table_2():
@@ -40,7 +40,7 @@ def test_a_custom_grid_needs_a_scenario_and_difficulties():
 
 def _sweep_command(tmp_path):
     return [
-        sys.executable, "-m", "train.sweep", "--grid", "custom", "--scenario", "two_colour", "--difficulties", "1",
+        sys.executable, "-m", "mjmaze.train.sweep", "--grid", "custom", "--scenario", "two_colour", "--difficulties", "1",
         "--seeds", "0", "1", "--total-steps", "960", "--num-envs", "2", "--num-steps", "8", "--checkpoint-every", "64",
         "--eval-configs", "2", "--eval-envs", "2", "--num-cpus", "2", "--cpus-per-run", "2",
         "--sweeps-dir", str(tmp_path), "--name", "tiny",

@@ -6,8 +6,9 @@ import math
 import pytest
 import torch
 
-from train import a2c, checkpoint, evaluate
-from train.model import Agent
+from mjmaze.train import settings as run_settings
+from mjmaze.train import a2c, checkpoint, evaluate
+from mjmaze.train.model import Agent
 
 
 def test_n_step_returns_match_a_hand_computation():
@@ -61,7 +62,7 @@ def tiny(tmp_path, **overrides):
         run_name="tiny", checkpoint_every=16, progress=False, torch_threads=1,
     )
     settings.update(overrides)
-    return a2c.Args(**settings)
+    return run_settings.Args(**settings)
 
 
 def test_two_update_smoke_run_writes_a_run_folder(tmp_path):
@@ -116,7 +117,7 @@ def test_a_checkpoint_of_another_run_is_refused(tmp_path):
 
 def test_flags_for_another_scenario_are_refused():
     with pytest.raises(ValueError, match="takes no \\['complexity'\\]"):
-        a2c.Args(scenario="labyrinth", complexity=3).task_kwargs()
+        run_settings.Args(scenario="labyrinth", complexity=3).task_kwargs()
 
 
 def test_evaluation_plays_every_configuration_twice(tmp_path, monkeypatch):
@@ -138,7 +139,7 @@ def test_sigterm_saves_a_final_checkpoint(tmp_path):
     import sys
     import time
 
-    command = [sys.executable, "-m", "train.a2c", "--size", "5", "--num-envs", "2", "--num-steps", "8",
+    command = [sys.executable, "-m", "mjmaze.train.a2c", "--size", "5", "--num-envs", "2", "--num-steps", "8",
                "--total-steps", "100000000", "--runs-dir", str(tmp_path), "--run-name", "term", "--no-progress",
                "--checkpoint-every", "1000000000"]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
@@ -175,7 +176,7 @@ def test_a_killed_env_worker_costs_the_run_nothing_but_its_rollout(tmp_path):
     import sys
     import time
 
-    command = [sys.executable, "-m", "train.a2c", "--size", "5", "--num-envs", "2", "--num-steps", "8",
+    command = [sys.executable, "-m", "mjmaze.train.a2c", "--size", "5", "--num-envs", "2", "--num-steps", "8",
                "--num-workers", "2", "--total-steps", "1600", "--runs-dir", str(tmp_path), "--run-name", "kill",
                "--no-progress", "--checkpoint-every", "1000000", "--torch-threads", "1"]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)

@@ -1,7 +1,7 @@
 """Hidden-state analysis, as in the paper's Fig. 1 and Fig. 7.
 
-    python -m train.analysis runs/two_colour_5_s0 --episodes 20
-    python -m train.analysis random --scenario two_colour --complexity 5 --episodes 4 --max-steps 100
+    python -m mjmaze.train.analysis runs/two_colour_5_s0 --episodes 20
+    python -m mjmaze.train.analysis random --scenario two_colour --complexity 5 --episodes 4 --max-steps 100
 
 Plays ``--episodes`` episodes (greedy; ``--sample`` to sample) on the test
 configurations, records the GRU state after every frame, and writes into
@@ -33,7 +33,8 @@ from matplotlib.figure import Figure
 
 import mjmaze
 from mjmaze import files, registry, suite
-from train import checkpoint, policy
+
+from . import checkpoint, policy
 
 TSNE_STATES = 2000
 TSNE_LINES = 20

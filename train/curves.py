@@ -1,13 +1,13 @@
 """Learning curves of one or several runs, mean +- std over seeds, in the style of the paper's figures.
 
-    python -m train.curves runs/lab5_s0 runs/lab5_s1 runs/lab7_s0 --out curves.png
-    python -m train.curves runs/lab5_s* --evaluate      # also greedy train/test at every kept checkpoint
+    python -m mjmaze.train.curves runs/lab5_s0 runs/lab5_s1 runs/lab7_s0 --out curves.png
+    python -m mjmaze.train.curves runs/lab5_s* --evaluate      # also greedy train/test at every kept checkpoint
 
 Runs with the same scenario and difficulty (config.json) are seeds of one curve
 and share a panel. Solid: the training episodes' metric from ``metrics.jsonl``
 (sampled actions, training mazes), averaged in ``--bins`` step bins. With
 ``--evaluate`` (or where a run already has them), greedy evaluations of each
-kept checkpoint on the training and test configurations (``train.evaluate``,
+kept checkpoint on the training and test configurations (``mjmaze.train.evaluate``,
 cached in ``<run>/evals/step_N.json``) are drawn as markers. Writes the PNG and
 ``<out>.json`` with every plotted number.
 """
@@ -22,8 +22,9 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from mjmaze import files, suite
-from train import checkpoint, evaluate
-from train.analysis import save_figure
+
+from . import checkpoint, evaluate
+from .analysis import save_figure
 
 BINS = 40
 

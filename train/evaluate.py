@@ -1,6 +1,6 @@
 """Greedy evaluation of a trained run on its training and test configurations.
 
-    python -m train.evaluate runs/labyrinth_5_s0 [--checkpoint PATH] [--num-envs 16]
+    python -m mjmaze.train.evaluate runs/labyrinth_5_s0 [--checkpoint PATH] [--num-envs 16]
 
 **Decision** (also in the README): each of the first 64 test configurations, and
 64 training ones, is played twice to its end or the time limit - 128 episodes
@@ -20,9 +20,10 @@ import torch
 
 from mjmaze import files, suite
 from mjmaze.vector import MazeVectorEnv
-from train import checkpoint, policy
-from train.a2c import Args, pick_device
-from train.model import Agent
+
+from . import checkpoint, policy
+from .settings import Args, pick_device
+from .model import Agent
 
 EVAL_CONFIGS = 64
 PLAYS_PER_CONFIG = 2

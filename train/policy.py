@@ -3,8 +3,8 @@
 :func:`load_run` reads a run's config and checkpoint; :class:`Policy` acts in one
 env, step by step, keeping the GRU state; :func:`play_episodes` plays episodes
 and returns :class:`Episode` records (poses, actions, rewards, hidden states,
-infos, frames and maps if asked). The videos (``train.record``) and the
-hidden-state analysis (``train.analysis``) are built on them.
+infos, frames and maps if asked). The videos (``mjmaze.train.record``) and the
+hidden-state analysis (``mjmaze.train.analysis``) are built on them.
 """
 
 from __future__ import annotations
@@ -19,9 +19,10 @@ import numpy as np
 import torch
 
 from mjmaze import suite, viz
-from train import checkpoint
-from train.a2c import Args
-from train.model import Agent
+
+from . import checkpoint
+from .settings import Args
+from .model import Agent
 
 RANDOM = "random"
 

@@ -1,7 +1,7 @@
 """Episode videos: the agent's view beside the top-down map with its path growing.
 
-    python -m train.record runs/labyrinth_5_s0 --episodes 4 --out episode.mp4
-    python -m train.record random --scenario k_item --num-items 4 --episodes 2 --out k_item.mp4
+    python -m mjmaze.train.record runs/labyrinth_5_s0 --episodes 4 --out episode.mp4
+    python -m mjmaze.train.record random --scenario k_item --num-items 4 --episodes 2 --out k_item.mp4
 
 Each frame shows the ego view (scaled 4x), the map as it is at that step (items
 vanish when picked up) with the path so far, and above them the run, the
@@ -22,7 +22,8 @@ import numpy as np
 
 import mjmaze
 from mjmaze import files, suite, viz
-from train import checkpoint, policy
+
+from . import checkpoint, policy
 
 FPS = 35 / 4  # real time: one frame per agent step (4 tics at 35 Hz)
 MAP_SIZE = 256

@@ -1,6 +1,6 @@
 """The results table of a sweep, in the layout of the paper's Table 2, with the paper's numbers beside ours.
 
-    python -m train.report sweeps/paper
+    python -m mjmaze.train.report sweeps/paper
 
 Reads every run folder of the sweep (``config.json``, ``eval.json``,
 ``metrics.jsonl``), groups the seeds of each (scenario, difficulty, training
@@ -12,7 +12,7 @@ set size), and writes into the sweep folder (or ``--out``):
   steps trained, and the paper's Table 2 (200M steps, 3 seeds) beside it;
 - ``report.csv``: the same rows, one column per number;
 - ``curves_<scenario>.png`` (+ ``.json``): the learning curves of each scenario
-  (``train.curves``), seeds averaged.
+  (``mjmaze.train.curves``), seeds averaged.
 
 Runs without ``eval.json`` yet (still training, or killed) are listed as such.
 """
@@ -28,7 +28,8 @@ import pathlib
 import numpy as np
 
 from mjmaze import files, registry, suite
-from train import curves
+
+from . import curves
 
 # The paper's Table 2 is each scenario's ``paper_results`` in mjmaze.registry.
 PAPER_STEPS = 200_000_000
@@ -86,7 +87,7 @@ def _cell(mean, std, scenario: str) -> str:
 
 def markdown(rows: list[dict], sweep_dir: pathlib.Path) -> str:
     episodes = sorted({r["episodes"] for r in rows if r["episodes"]})
-    intro = (f"Greedy evaluation (`train.evaluate`: {'/'.join(map(str, episodes)) or 'no'} episodes per split, each "
+    intro = (f"Greedy evaluation (`mjmaze.train.evaluate`: {'/'.join(map(str, episodes)) or 'no'} episodes per split, each "
              "configuration played twice); mean ± std over seeds. Paper: Table 2 of Beeching et al. (ViZDoom, "
              f"{PAPER_STEPS // 1_000_000}M steps, 3 seeds).")
     lines = [f"# Results of `{sweep_dir}`", "", intro, ""]

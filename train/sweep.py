@@ -1,18 +1,18 @@
 """The paper's experiment grid on Ray: one training run per (scenario, difficulty, seed), each then evaluated.
 
-    python -m train.sweep --grid small --total-steps 1000000     # Labyrinth 5 and 7 x 2 seeds
-    python -m train.sweep --grid paper                           # Table 2: 4 scenarios x 4 difficulties x 3 seeds, 200M steps
-    python -m train.sweep --grid generalisation                  # Labyrinth 9 with 16/64/256/1024 training mazes x 3 seeds
-    python -m train.sweep --grid custom --scenario k_item --difficulties 2 4 --seeds 0 1
-    python -m train.sweep --grid paper --address auto --cpus-per-run 4 --gpus-per-run 0.25   # an existing cluster
-    python -m train.report sweeps/paper                          # the table and curves
+    python -m mjmaze.train.sweep --grid small --total-steps 1000000     # Labyrinth 5 and 7 x 2 seeds
+    python -m mjmaze.train.sweep --grid paper                           # Table 2: 4 scenarios x 4 difficulties x 3 seeds, 200M steps
+    python -m mjmaze.train.sweep --grid generalisation                  # Labyrinth 9 with 16/64/256/1024 training mazes x 3 seeds
+    python -m mjmaze.train.sweep --grid custom --scenario k_item --difficulties 2 4 --seeds 0 1
+    python -m mjmaze.train.sweep --grid paper --address auto --cpus-per-run 4 --gpus-per-run 0.25   # an existing cluster
+    python -m mjmaze.train.report sweeps/paper                          # the table and curves
 
 Each run is a Ray task (local Ray by default; ``--address`` joins a cluster,
 whose nodes need mjmaze installed and a shared ``--sweeps-dir``) holding
 ``--cpus-per-run`` CPUs (its env workers) and ``--gpus-per-run`` of a GPU.
 Everything lands in ``sweeps/<name>/``: ``sweep.json`` (the grid and flags) and
-one run folder per run, laid out as ``train.a2c`` does, with ``eval.json``
-(``train.evaluate``) written as the run ends.
+one run folder per run, laid out as ``mjmaze.train.a2c`` does, with ``eval.json``
+(``mjmaze.train.evaluate``) written as the run ends.
 
 **Resumable**: run the same command again. A run whose ``eval.json`` covers
 the full ``--total-steps`` is never redone; a crashed or killed one goes on from
@@ -31,7 +31,9 @@ import sys
 import time
 
 from mjmaze import files, registry, suite
-from train import a2c, checkpoint, evaluate
+
+from . import a2c, checkpoint, evaluate
+from .settings import Args
 
 GENERALISATION_CONFIGS = (16, 64, 256, 1024)
 # The generalisation study's maze size: the paper does not state it; Labyrinth's default.
@@ -54,9 +56,9 @@ class RunSpec:
         configs = f"_n{self.num_configs}" if self.num_configs else ""
         return f"{self.scenario}_{registry.get(self.scenario).difficulty}{self.difficulty}{configs}_s{self.seed}"
 
-    def args(self, settings: dict, runs_dir: pathlib.Path) -> a2c.Args:
+    def args(self, settings: dict, runs_dir: pathlib.Path) -> Args:
         """The training flags of this run: ``settings`` (shared by the sweep) plus its own."""
-        return a2c.Args(**{
+        return Args(**{
             **settings, "scenario": self.scenario, registry.get(self.scenario).difficulty: self.difficulty, "seed": self.seed,
             "num_configs": self.num_configs, "runs_dir": str(runs_dir), "run_name": self.name, "progress": False,
         })
@@ -175,8 +177,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--num-configs", type=int, nargs="+", default=None, help="--grid custom: training set sizes")
     parser.add_argument("--total-steps", type=int, default=None,
                         help=f"agent steps per run (default: {DEFAULT_STEPS})")
-    parser.add_argument("--num-envs", type=int, default=a2c.Args.num_envs)
-    parser.add_argument("--num-steps", type=int, default=a2c.Args.num_steps)
+    parser.add_argument("--num-envs", type=int, default=Args.num_envs)
+    parser.add_argument("--num-steps", type=int, default=Args.num_steps)
     parser.add_argument("--checkpoint-every", type=int, default=None, help="default: total steps / 20")
     parser.add_argument("--device", default="auto", help="auto (CUDA where Ray gives the task a GPU), cpu, cuda")
     parser.add_argument("--address", default=None, help="an existing Ray cluster ('auto' or host:port)")
@@ -217,7 +219,7 @@ def main(argv: list[str] | None = None) -> None:
         raise SystemExit(f"error: {error}") from None
     failed = [r for r in results if r["status"].startswith("failed")]
     print(f"[sweep] {len(results) - len(failed)}/{len(results)} runs finished in {sweep_dir}; "
-          f"table: python -m train.report {sweep_dir}")
+          f"table: python -m mjmaze.train.report {sweep_dir}")
     if failed:
         raise SystemExit(f"error: {len(failed)} run(s) failed: {', '.join(r['name'] for r in failed)}; "
                          "run the same command again to resume them")
