@@ -8,6 +8,8 @@ PY := $(VENV)/bin/python
 # distribution still ships it (newer Mesa releases dropped libosmesa6).
 GL_PACKAGES := libegl1 libgl1 libgl1-mesa-dri libegl-mesa0 libglx-mesa0
 OPTIONAL_GL_PACKAGES := libosmesa6
+# For the test of the play window under a real X display (skipped without them).
+TEST_PACKAGES := xvfb xdotool
 # Installed only when no torch is there yet: install your own (a CUDA build,
 # say) into .venv first to train on a GPU.
 TORCH ?= torch==2.13.0
@@ -21,14 +23,14 @@ ifndef RUN_NAME
 RUN_NAME := labyrinth5_$(shell date +%Y%m%d-%H%M%S)
 endif
 
-.PHONY: run test bench setup system-deps clean
+.PHONY: run test bench setup system-deps test-deps clean
 
 run: system-deps $(VENV)/.stamp-torch $(VENV)/.stamp-train,viz
 	$(PY) -m mjmaze.train.a2c --scenario labyrinth --size 5 --total-steps $(RUN_STEPS) \
 	  --run-name $(RUN_NAME) --checkpoint-every 250000
 	$(PY) -m mjmaze.train.evaluate runs/$(RUN_NAME)
 
-test: system-deps $(VENV)/.stamp-torch $(VENV)/.stamp-train,dev
+test: system-deps test-deps $(VENV)/.stamp-torch $(VENV)/.stamp-train,dev
 	$(PY) -m pytest -q
 
 bench: system-deps $(VENV)/.stamp-bench
@@ -52,6 +54,14 @@ system-deps:
 	for p in $$optional; do \
 	  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $$p >/dev/null 2>&1 \
 	    || echo "$$p is not available here: rendering uses EGL only"; done
+
+test-deps:
+	@command -v dpkg >/dev/null || exit 0; \
+	missing=$$(for p in $(TEST_PACKAGES); do dpkg -s $$p >/dev/null 2>&1 || echo $$p; done); \
+	if [ -z "$$missing" ]; then exit 0; fi; \
+	if [ "$$(id -u)" != 0 ]; then echo "Without $$missing the play-window test is skipped (sudo apt-get install $$missing)"; exit 0; fi; \
+	apt-get update -qq; DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $$missing >/dev/null 2>&1 \
+	  || echo "Could not install $$missing: the play-window test is skipped"
 
 $(VENV)/bin/python:
 	@$(PYTHON) -c 'import sys; sys.exit(sys.version_info < (3, 10))' || { echo "mjmaze needs Python >= 3.10"; exit 1; }

@@ -15,6 +15,7 @@ replays one step per token (letters from w, a, s, d), then writes the same files
 from __future__ import annotations
 
 import argparse
+import os
 import pathlib
 import time
 
@@ -117,6 +118,11 @@ def replay(session: PlaySession, tokens: list[str]) -> None:
 
 def run_window(session: PlaySession, max_frames: int | None = None) -> None:
     """The interactive loop: keys held -> one step per frame at real time; R new episode; Esc/Q quits."""
+    # SDL would draw the window through an OpenGL (GLX) framebuffer, whose
+    # context clashes with the EGL one MuJoCo renders with in this process
+    # (X error BadAccess in X_GLXMakeCurrent); a plain software framebuffer
+    # costs nothing at this size. Set before pygame loads SDL; a user's choice wins.
+    os.environ.setdefault("SDL_FRAMEBUFFER_ACCELERATION", "0")
     import pygame
 
     pygame.display.init()  # no audio: nothing here plays sound

@@ -165,3 +165,55 @@ def test_the_window_steps_while_a_key_is_held(monkeypatch):
         assert len(session.episodes) == 1 and session.episodes[0]["steps"] == 4
     finally:
         session.close()
+
+
+@pytest.fixture
+def x_display():
+    """A virtual X display (Xvfb), as a person at a desktop has one."""
+    import shutil
+    import subprocess
+    import time
+
+    if not (shutil.which("Xvfb") and shutil.which("xdotool")):
+        pytest.skip("needs Xvfb and xdotool (make test installs them: apt-get install xvfb xdotool)")
+    number = 90 + os.getpid() % 100
+    server = subprocess.Popen(["Xvfb", f":{number}", "-screen", "0", "1024x768x24", "-nolisten", "tcp"],
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 20
+    while not os.path.exists(f"/tmp/.X11-unix/X{number}"):
+        assert server.poll() is None and time.monotonic() < deadline, "Xvfb did not start"
+        time.sleep(0.05)
+    yield f":{number}"
+    server.terminate()
+    server.wait(timeout=10)
+
+
+def test_the_play_window_under_a_real_x_display_takes_keys(tmp_path, x_display):
+    import subprocess
+    import sys
+
+    pytest.importorskip("pygame")
+    env = {key: value for key, value in os.environ.items() if key not in ("MUJOCO_GL", "SDL_VIDEODRIVER", "PYOPENGL_PLATFORM")}
+    env["DISPLAY"] = x_display
+    out = tmp_path / "play"
+    game = subprocess.Popen([sys.executable, "-m", "mjmaze.play", "--scenario", "labyrinth", "--size", "5",
+                             "--out", str(out)], env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        # By process id: SDL sets the title as a UTF-8 WM_NAME, which `search --name` misses.
+        found = subprocess.run(["xdotool", "search", "--sync", "--pid", str(game.pid)], env=env, capture_output=True,
+                               text=True, timeout=90)
+        window = found.stdout.split()[0]
+        xdo = lambda *args: subprocess.run(["xdotool", *args], env=env, check=True, timeout=20)  # noqa: E731
+        xdo("windowfocus", "--sync", window)
+        xdo("keydown", "w")
+        xdo("sleep", "1")
+        xdo("keyup", "w")
+        xdo("key", "Escape")
+        output, _ = game.communicate(timeout=60)
+    finally:
+        if game.poll() is None:
+            game.kill()
+    assert game.returncode == 0 and "X Error" not in output, output
+    session = json.loads((out / "session.json").read_text())
+    assert session["actions"] and set(session["actions"]) == {2}  # forward while W was held
+    assert iio.imread(out / "screen.png").std() > 0
