@@ -170,7 +170,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--keys-file", type=pathlib.Path, default=None, help="headless: key tokens from a file")
     parser.add_argument("--out", type=pathlib.Path, default=None, help="default: runs/play/<scenario>_<time>")
     args = parser.parse_args(argv)
-    scenario = args.scenario or "labyrinth"
+    scenario = args.scenario or suite.DEFAULT_SCENARIO
     out = args.out or pathlib.Path("runs/play") / f"{scenario}_{time.strftime('%Y%m%d-%H%M%S')}"
     task_kwargs = {"split": args.split, "action_set": args.action_set, **suite.difficulty_kwargs(args)}
     try:

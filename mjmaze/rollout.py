@@ -56,7 +56,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("runs/rollout/frames.png"))
     args = parser.parse_args(argv)
 
-    args.scenario = args.scenario or "labyrinth"
+    args.scenario = args.scenario or suite.DEFAULT_SCENARIO
     difficulty = suite.difficulty_kwargs(args)
     result = rollout(args.scenario, args.steps, args.seed, args.strip_frames, split=args.split, **difficulty)
     print(f"{args.scenario} {difficulty} ({args.split}), random policy, {args.steps} agent steps")

@@ -41,6 +41,8 @@ def _collect() -> tuple[str, ...]:
     return registry.names()
 
 
+#: What the command-line tools play when no --scenario is given.
+DEFAULT_SCENARIO = "labyrinth"
 #: The scenarios that ship with mjmaze (the paper's four), in the paper's order.
 ALL_TASKS = tuple(sorted(_collect(), key=lambda name: registry.get(name).seed_code))
 
@@ -91,7 +93,7 @@ def difficulty_arguments(parser: argparse.ArgumentParser) -> None:
     One flag per difficulty argument of the registered scenarios (``--size``,
     ``--num-items``, ``--complexity``), each naming the scenarios it sets.
     """
-    parser.add_argument("--scenario", default=None, choices=registry.names(), help="default: labyrinth")
+    parser.add_argument("--scenario", default=None, choices=registry.names(), help=f"default: {DEFAULT_SCENARIO}")
     for name, scenarios in _difficulty_names().items():
         parser.add_argument(f"--{name.replace('_', '-')}", type=int, default=None, help=f"{name} ({', '.join(scenarios)})")
 

@@ -187,7 +187,7 @@ class MazeVectorEnv(gym.vector.VectorEnv):
     def __init__(
         self,
         num_envs: int,
-        scenario: str = "labyrinth",
+        scenario: str = suite.DEFAULT_SCENARIO,
         num_workers: int | None = None,
         autoreset_mode: str | AutoresetMode = "next_step",
         copy: bool = True,

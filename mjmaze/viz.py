@@ -212,7 +212,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("runs/maps/map.png"))
     args = parser.parse_args(argv)
     try:
-        env = mjmaze.load(args.scenario or "labyrinth", task_kwargs={
+        env = mjmaze.load(args.scenario or suite.DEFAULT_SCENARIO, task_kwargs={
             "split": args.split, "first_config": args.config, "random": args.seed, **suite.difficulty_kwargs(args),
         })
     except ValueError as error:
@@ -231,7 +231,7 @@ def main(argv: list[str] | None = None) -> None:
     env.task.close()
     save_png(args.out, image)
     config = env.task.config
-    print(f"{args.scenario or 'labyrinth'} {suite.difficulty_kwargs(args)} {args.split} configuration {config.index}: {args.out}")
+    print(f"{args.scenario or suite.DEFAULT_SCENARIO} {suite.difficulty_kwargs(args)} {args.split} configuration {config.index}: {args.out}")
 
 
 if __name__ == "__main__":

@@ -51,11 +51,15 @@ def test_a_tiny_grid_survives_a_kill_resumes_without_redoing_and_reports(tmp_pat
     first, second = tmp_path / "tiny" / "two_colour_complexity1_s0", tmp_path / "tiny" / "two_colour_complexity1_s1"
     # 1. Start the grid (runs one at a time on 2 CPUs) and kill everything once the first run has
     #    finished and the second has a checkpoint but no evaluation.
-    process = subprocess.Popen(_sweep_command(tmp_path), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                               start_new_session=True)
+    # Output goes to a file: a pipe nobody reads until the end can fill up and
+    # block the sweep, which then never reaches the state waited for.
+    log = tmp_path / "first_attempt.log"
+    with open(log, "w") as out:
+        process = subprocess.Popen(_sweep_command(tmp_path), stdout=out, stderr=subprocess.STDOUT, text=True,
+                                   start_new_session=True)
     deadline = time.monotonic() + 240
     while not ((first / "eval.json").exists() and list((second / "checkpoints").glob("*.pt"))):
-        assert process.poll() is None and time.monotonic() < deadline, process.stdout.read()
+        assert process.poll() is None and time.monotonic() < deadline, log.read_text()
         time.sleep(0.02)
     os.killpg(process.pid, signal.SIGKILL)
     process.wait(timeout=30)

@@ -180,7 +180,7 @@ def policy_from_arguments(args: argparse.Namespace) -> tuple[str, dict, Policy, 
     """
     flags = suite.difficulty_kwargs(args)
     if args.source == RANDOM:
-        scenario = args.scenario or "labyrinth"
+        scenario = args.scenario or suite.DEFAULT_SCENARIO
         task_kwargs = Args(scenario=scenario, **flags).task_kwargs()  # checks the scenario and flags
         torch.manual_seed(args.seed)
         policy = Policy(new_agent(scenario, task_kwargs), "uniform", args.seed)

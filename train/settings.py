@@ -17,8 +17,8 @@ from mjmaze import suite
 class Args:
     """Train the paper's A2C baseline on one mjmaze scenario."""
 
-    scenario: str = "labyrinth"
-    """labyrinth, find_return, k_item or two_colour"""
+    scenario: str = suite.DEFAULT_SCENARIO
+    """a registered scenario (mjmaze.registry.names(): labyrinth, find_return, k_item, two_colour, ...)"""
     size: int | None = None
     """maze size n (Labyrinth, Find-and-return; K-item's grid); None: the scenario's default"""
     num_items: int | None = None
