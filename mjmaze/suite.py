@@ -33,18 +33,21 @@ def register(scenario: registry.Scenario) -> registry.Scenario:
 
 
 def _collect() -> tuple[str, ...]:
-    """Registers the ``SCENARIO`` of every module in :mod:`mjmaze.tasks`, in name order."""
-    for module_info in sorted(pkgutil.iter_modules(tasks.__path__), key=lambda m: m.name):
+    """Registers the ``SCENARIO`` of every module in :mod:`mjmaze.tasks`, in seed-code order."""
+    declared = []
+    for module_info in pkgutil.iter_modules(tasks.__path__):
         module = importlib.import_module(f"{tasks.__name__}.{module_info.name}")
         if isinstance(getattr(module, "SCENARIO", None), registry.Scenario):
-            register(module.SCENARIO)
-    return registry.names()
+            declared.append(module.SCENARIO)
+    for scenario in sorted(declared, key=lambda s: s.seed_code):
+        register(scenario)
+    return tuple(scenario.name for scenario in sorted(declared, key=lambda s: s.seed_code))
 
 
 #: What the command-line tools play when no --scenario is given.
 DEFAULT_SCENARIO = "labyrinth"
 #: The scenarios that ship with mjmaze (the paper's four), in the paper's order.
-ALL_TASKS = tuple(sorted(_collect(), key=lambda name: registry.get(name).seed_code))
+ALL_TASKS = _collect()
 
 
 def paper_metric(name: str) -> tuple[str, float, str]:
@@ -94,16 +97,16 @@ def difficulty_arguments(parser: argparse.ArgumentParser) -> None:
     ``--num-items``, ``--complexity``), each naming the scenarios it sets.
     """
     parser.add_argument("--scenario", default=None, choices=registry.names(), help=f"default: {DEFAULT_SCENARIO}")
-    for name, scenarios in _difficulty_names().items():
+    for name, scenarios in difficulty_names().items():
         parser.add_argument(f"--{name.replace('_', '-')}", type=int, default=None, help=f"{name} ({', '.join(scenarios)})")
 
 
 def difficulty_kwargs(args: argparse.Namespace) -> dict:
     """The task arguments of the flags added by :func:`difficulty_arguments` that were given."""
-    return {name: getattr(args, name) for name in _difficulty_names() if getattr(args, name, None) is not None}
+    return {name: getattr(args, name) for name in difficulty_names() if getattr(args, name, None) is not None}
 
 
-def _difficulty_names() -> dict[str, list[str]]:
+def difficulty_names() -> dict[str, list[str]]:
     """Difficulty argument -> the scenarios it is the difficulty of."""
     names: dict[str, list[str]] = {}
     for scenario in registry.all_scenarios():

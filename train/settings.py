@@ -7,24 +7,20 @@ none of them imports the training loop.
 from __future__ import annotations
 
 import dataclasses
+from typing import Annotated
 
 import torch
+import tyro
 
-from mjmaze import suite
+from mjmaze import registry, suite
 
 
 @dataclasses.dataclass
-class Args:
+class _RunSettings:
     """Train the paper's A2C baseline on one mjmaze scenario."""
 
     scenario: str = suite.DEFAULT_SCENARIO
     """a registered scenario (mjmaze.registry.names(): labyrinth, find_return, k_item, two_colour, ...)"""
-    size: int | None = None
-    """maze size n (Labyrinth, Find-and-return; K-item's grid); None: the scenario's default"""
-    num_items: int | None = None
-    """K for Ordered K-item"""
-    complexity: int | None = None
-    """complexity c for Two-colour"""
     num_configs: int | None = None
     """training configurations (None: 256; the paper's study: 16, 64, 256, 1024)"""
     total_steps: int = 10_000_000
@@ -70,7 +66,7 @@ class Args:
 
     def task_kwargs(self) -> dict:
         """The scenario's task arguments from these flags."""
-        kwargs = {"size": self.size, "num_items": self.num_items, "complexity": self.complexity}
+        kwargs = {name: getattr(self, name) for name in DIFFICULTY_FLAGS}
         allowed = set(kwargs) & set(suite.task_kwarg_names(self.scenario))  # raises on an unknown scenario
         extra = {k for k, v in kwargs.items() if v is not None} - allowed
         if extra:
@@ -83,8 +79,28 @@ class Args:
     def name(self) -> str:
         if self.run_name:
             return self.run_name
-        difficulty = self.size or self.num_items or self.complexity or "default"
-        return f"{self.scenario}_{difficulty}_s{self.seed}"
+        difficulty = registry.get(self.scenario).difficulty
+        return f"{self.scenario}_{getattr(self, difficulty, None) or 'default'}_s{self.seed}"
+
+
+# One flag per difficulty argument of the registered scenarios (--size,
+# --num-items, --complexity), read from the registry like the other tools'
+# flags (mjmaze.suite.difficulty_arguments): a scenario added in mjmaze/tasks/
+# brings its own.
+DIFFICULTY_FLAGS = {
+    name: f"the difficulty of {', '.join(scenarios)} (None: the scenario's default)"
+    for name, scenarios in suite.difficulty_names().items()
+}
+Args = dataclasses.make_dataclass(
+    "Args",
+    [
+        (name, Annotated[int | None, tyro.conf.arg(help=help_text)], dataclasses.field(default=None))
+        for name, help_text in DIFFICULTY_FLAGS.items()
+    ],
+    bases=(_RunSettings,),
+    namespace={"__doc__": _RunSettings.__doc__},
+)
+Args.__module__ = __name__  # so that runs pickle (Ray, checkpoints) by this module's name
 
 
 def pick_device(name: str) -> torch.device:
