@@ -132,24 +132,34 @@ def test_evaluation_plays_every_configuration_twice(tmp_path, monkeypatch):
     assert saved["test"]["episodes"] == 16 and saved["units"] == "success %"
 
 
-def test_sigterm_saves_a_final_checkpoint(tmp_path):
-    import os
-    import signal
+def start_training(tmp_path, name: str, *flags: str):
+    """``python -m mjmaze.train.a2c`` on Labyrinth 5x5 in a subprocess, once it has logged two updates."""
     import subprocess
     import sys
     import time
 
     command = [sys.executable, "-m", "mjmaze.train.a2c", "--size", "5", "--num-envs", "2", "--num-steps", "8",
-               "--total-steps", "100000000", "--runs-dir", str(tmp_path), "--run-name", "term", "--no-progress",
-               "--checkpoint-every", "1000000000"]
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    metrics = tmp_path / "term" / "metrics.jsonl"
+               "--runs-dir", str(tmp_path), "--run-name", name, "--no-progress", *flags]
+    # Output to a file: an unread pipe can fill up and block the run.
+    log = tmp_path / f"{name}.log"
+    with open(log, "w") as out:
+        process = subprocess.Popen(command, stdout=out, stderr=subprocess.STDOUT, text=True)
+    metrics = tmp_path / name / "metrics.jsonl"
     deadline = time.monotonic() + 120
     while not (metrics.exists() and metrics.read_text().count("\n") >= 2):
-        assert process.poll() is None and time.monotonic() < deadline, process.stdout.read()
-        time.sleep(0.2)
+        assert process.poll() is None and time.monotonic() < deadline, log.read_text()
+        time.sleep(0.05)
+    return process, log
+
+
+def test_sigterm_saves_a_final_checkpoint(tmp_path):
+    import os
+    import signal
+
+    process, log = start_training(tmp_path, "term", "--total-steps", "100000000", "--checkpoint-every", "1000000000")
     os.kill(process.pid, signal.SIGTERM)
-    output, _ = process.communicate(timeout=60)
+    process.wait(timeout=60)
+    output = log.read_text()
     assert process.returncode == 130, output
     saved = checkpoint.checkpoints(tmp_path / "term" / "checkpoints")
     assert len(saved) == 1 and checkpoint.load(saved[0])["step"] >= 32
@@ -172,24 +182,15 @@ def _env_workers(pid: int) -> list[int]:
 def test_a_killed_env_worker_costs_the_run_nothing_but_its_rollout(tmp_path):
     import os
     import signal
-    import subprocess
-    import sys
-    import time
 
-    command = [sys.executable, "-m", "mjmaze.train.a2c", "--size", "5", "--num-envs", "2", "--num-steps", "8",
-               "--num-workers", "2", "--total-steps", "1600", "--runs-dir", str(tmp_path), "--run-name", "kill",
-               "--no-progress", "--checkpoint-every", "1000000", "--torch-threads", "1"]
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    metrics = tmp_path / "kill" / "metrics.jsonl"
-    deadline = time.monotonic() + 120
-    while not (metrics.exists() and metrics.read_text().count("\n") >= 2):
-        assert process.poll() is None and time.monotonic() < deadline, process.stdout.read()
-        time.sleep(0.05)
+    process, log = start_training(tmp_path, "kill", "--num-workers", "2", "--total-steps", "1600",
+                                  "--checkpoint-every", "1000000", "--torch-threads", "1")
     os.kill(_env_workers(process.pid)[0], signal.SIGKILL)
-    output, _ = process.communicate(timeout=240)
+    process.wait(timeout=240)
+    output = log.read_text()
     assert process.returncode == 0, output
     assert "rebuilding the envs" in output and "Traceback" not in output
-    lines = [json.loads(line) for line in metrics.read_text().splitlines()]
+    lines = [json.loads(line) for line in (tmp_path / "kill" / "metrics.jsonl").read_text().splitlines()]
     assert lines[-1]["step"] == 1600 and lines[-1]["env_rebuilds"] == 1
     assert checkpoint.load(checkpoint.checkpoints(tmp_path / "kill" / "checkpoints")[-1])["step"] == 1600
 
