@@ -235,7 +235,7 @@ class MazeTask(base.Task):
 
         ``path`` ``(tics, 2)`` holds the agent's ``(x, y)`` after each tic of the
         step, so a pick-up passed in the middle of a step counts (Doom tests
-        every tic); see :func:`reached`.
+        every tic); see :func:`touches` and :func:`reached`.
         """
 
     @abc.abstractmethod
@@ -353,13 +353,20 @@ def within_pickup(xy, x: float, y: float) -> bool:
     return dx * dx + dy * dy < PICKUP_RADIUS * PICKUP_RADIUS
 
 
+def _first_tic(px: float, py: float, tics: list) -> int:
+    """The first of ``tics`` (``[x, y]`` lists) within pick-up range of ``(px, py)``, -1 if none.
+
+    Plain floats: for 4 tics they beat numpy's per-call cost.
+    """
+    for tic, (x, y) in enumerate(tics):
+        if (x - px) ** 2 + (y - py) ** 2 < PICKUP_RADIUS * PICKUP_RADIUS:
+            return tic
+    return -1
+
+
 def touches(xy, path: np.ndarray) -> bool:
     """True if ``path`` (the agent's positions after each tic of a step) comes within pick-up range of ``xy``."""
-    px, py = xy
-    for x, y in path.tolist():  # 4 tics: plain floats beat numpy's per-call cost
-        if (x - px) ** 2 + (y - py) ** 2 < PICKUP_RADIUS * PICKUP_RADIUS:
-            return True
-    return False
+    return _first_tic(xy[0], xy[1], path.tolist()) >= 0
 
 
 def reached(points: np.ndarray, path: np.ndarray) -> np.ndarray:
@@ -377,11 +384,7 @@ def reached(points: np.ndarray, path: np.ndarray) -> np.ndarray:
     reach = PICKUP_RADIUS + max(math.hypot(x - end_x, y - end_y) for x, y in tics)
     near = np.flatnonzero(((points - tics[-1]) ** 2).sum(axis=1) < reach * reach)
     for k in near.tolist():
-        px, py = points[k].tolist()
-        for tic, (x, y) in enumerate(tics):
-            if (x - px) ** 2 + (y - py) ** 2 < PICKUP_RADIUS * PICKUP_RADIUS:
-                first[k] = tic
-                break
+        first[k] = _first_tic(*points[k].tolist(), tics)
     return first
 
 
