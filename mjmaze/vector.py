@@ -27,6 +27,7 @@ memory.
 
 from __future__ import annotations
 
+import contextlib
 import multiprocessing as mp
 import multiprocessing.connection
 import os
@@ -35,6 +36,7 @@ import signal
 import sys
 import time
 import traceback
+import types
 from multiprocessing import shared_memory
 from typing import Any
 
@@ -47,6 +49,8 @@ from gymnasium.vector.utils import batch_space
 from mjmaze import registry, suite
 
 SHARED_MEMORY_PREFIX = "mjmaze_"
+# How long a waiting process polls before it sleeps (see _spin_then_block).
+SPIN_SECONDS = 0.002
 AUTORESET_MODES = {"next_step": AutoresetMode.NEXT_STEP, "same_step": AutoresetMode.SAME_STEP}
 
 
@@ -93,7 +97,90 @@ def _write_info(columns: dict[str, np.ndarray], slot: int, info: dict) -> None:
         columns[key][slot] = value
 
 
-def _worker(worker_id, conn, shm_name, layout, env_ids, first_configs, scenario, task_kwargs, same_step):
+class _EnvGroup:
+    """The envs one process steps (a worker's share, or the calling process's).
+
+    The lean path: :meth:`mjmaze.tasks.base.MazeTask.advance` and a render
+    straight into the env's slot of the shared observations, results written
+    into the shared columns; no ``TimeStep`` or observation dict per step.
+    Autoreset is done here, as the module docstring describes.
+    """
+
+    def __init__(self, arrays: dict[str, np.ndarray], slots: list[int], first_configs: list[int], scenario: str,
+                 task_kwargs: dict, same_step: bool):
+        self._obs, self._actions = arrays["obs"], arrays["actions"]
+        scalars = arrays["scalars"]
+        self._columns = {name: scalars[name] for name in scalars.dtype.names}
+        self._same_step = same_step
+        if same_step:
+            self._final_obs = arrays["final_obs"]
+            self._final_columns = {name: arrays["final_scalars"][name] for name in scalars.dtype.names}
+        self._envs = []
+        self._ended = [False] * len(slots)  # next-step mode: the env resets on its next step
+        for slot, first in zip(slots, first_configs):
+            env = suite.load(scenario, {**task_kwargs, "first_config": first})
+            env.task.observation_buffer = self._obs[slot]
+            self._envs.append((slot, env, env.task, env.physics))
+
+    def reset(self, seeds: list[int] | None) -> None:
+        for i, (slot, env, task, _) in enumerate(self._envs):
+            if seeds is not None:
+                task.reseed(seeds[slot])
+            self._restart(i, slot, env)
+
+    def _restart(self, i: int, slot: int, env) -> None:
+        env.reset()  # renders the first frame into the env's slot
+        self._ended[i] = False
+        columns = self._columns
+        columns["reward"][slot] = 0.0
+        columns["terminated"][slot] = columns["truncated"][slot] = False
+        _write_info(columns, slot, env.task.get_info(env.physics))
+
+    def step(self) -> None:
+        columns, actions = self._columns, self._actions
+        for i, (slot, env, task, physics) in enumerate(self._envs):
+            if self._ended[i]:  # the step after an episode's end: its action is ignored
+                self._restart(i, slot, env)
+                continue
+            reward, terminated, truncated = task.advance(physics, actions[slot])
+            task.get_observation(physics)
+            columns["reward"][slot] = reward
+            columns["terminated"][slot] = terminated
+            columns["truncated"][slot] = truncated
+            if terminated or truncated:
+                if not self._same_step:
+                    self._ended[i] = True
+                else:
+                    self._final_obs[slot] = self._obs[slot]
+                    _write_info(self._final_columns, slot, task.get_info(physics))
+                    env.reset()
+            _write_info(columns, slot, task.get_info(physics))
+
+    def close(self) -> None:
+        for _, _, task, _ in self._envs:
+            task.observation_buffer = None
+            task.close()
+        self._envs = []
+
+
+def _spin_then_block(conn, spin_seconds: float) -> None:
+    """Returns once ``conn`` can be read: polls for up to ``spin_seconds``, then sleeps.
+
+    A process that sleeps between steps wakes up late (~0.2 ms on a virtual
+    machine) and slow (caches gone cold): measured, a worker that blocked on its
+    pipe took ~600 us per env step against ~500 us for one that polled
+    (bench/multiproc.py). Polling only pays while every process has its own
+    core, so the vector env polls only then.
+    """
+    clock = time.perf_counter
+    spin_until = clock() + spin_seconds
+    while clock() < spin_until:
+        if conn.poll(0):
+            return
+    conn.poll(None)
+
+
+def _worker(worker_id, conn, shm_name, layout, env_ids, first_configs, scenario, task_kwargs, same_step, spin_seconds):
     """A worker's loop: build its envs, then answer step / reset / close commands.
 
     ``scenario`` is the declaration (:class:`mjmaze.registry.Scenario`), not a
@@ -103,50 +190,26 @@ def _worker(worker_id, conn, shm_name, layout, env_ids, first_configs, scenario,
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
     segment = _attach(shm_name)
     arrays = _views(layout, segment.buf)
-    scalars = arrays["scalars"]
-    columns = {name: scalars[name] for name in scalars.dtype.names}
-    final_columns = {name: arrays["final_scalars"][name] for name in scalars.dtype.names} if same_step else None
     busy = arrays["busy_seconds"]
-    envs = []
+    group = None
     try:
         suite.register(scenario)
-        for slot, first in zip(env_ids, first_configs):
-            env = suite.load(scenario.name, {**task_kwargs, "first_config": first})
-            env.task.observation_buffer = arrays["obs"][slot]
-            envs.append((slot, env))
+        group = _EnvGroup(arrays, env_ids, first_configs, scenario.name, task_kwargs, same_step)
         conn.send(None)
         clock = time.perf_counter
         while True:
+            _spin_then_block(conn, spin_seconds)
             command, argument = conn.recv()
             started = clock()
             if command == "step":
-                actions = arrays["actions"]
-                for slot, env in envs:
-                    timestep = env.step(actions[slot])
-                    ended = timestep.last()
-                    terminated = ended and timestep.discount == 0.0
-                    columns["reward"][slot] = timestep.reward or 0.0
-                    columns["terminated"][slot] = terminated
-                    columns["truncated"][slot] = ended and not terminated
-                    if ended and same_step:
-                        arrays["final_obs"][slot] = arrays["obs"][slot]
-                        _write_info(final_columns, slot, env.task.get_info(env.physics))
-                        env.reset()
-                    _write_info(columns, slot, env.task.get_info(env.physics))
+                group.step()
+                busy[worker_id] += clock() - started
             elif command == "reset":
-                for slot, env in envs:
-                    if argument is not None:
-                        env.task.reseed(argument[slot])
-                    env.reset()
-                    columns["reward"][slot] = 0.0
-                    columns["terminated"][slot] = columns["truncated"][slot] = False
-                    _write_info(columns, slot, env.task.get_info(env.physics))
+                group.reset(argument)
             elif command == "close":
                 break
             else:
                 raise ValueError(f"unknown command {command!r}")
-            if command == "step":
-                busy[worker_id] += clock() - started
             conn.send(None)
     except BaseException as error:  # noqa: BLE001 - report anything to the parent, then exit
         try:
@@ -154,12 +217,34 @@ def _worker(worker_id, conn, shm_name, layout, env_ids, first_configs, scenario,
         except (OSError, ValueError):
             pass
     finally:
-        for _, env in envs:
-            env.task.observation_buffer = None
-            env.task.close()
-        del arrays, scalars, columns, final_columns, envs, busy
+        if group is not None:
+            group.close()
+        del arrays, busy, group
         segment.close()
         conn.close()
+
+
+@contextlib.contextmanager
+def _main_module_hidden(scenario: registry.Scenario):
+    """Spawned workers skip re-importing the caller's ``__main__``.
+
+    ``spawn`` runs the parent's main script again in every worker, so that
+    objects it defines can be unpickled there. A worker needs nothing from it
+    unless the scenario's task class is defined there; a training script's
+    ``__main__`` would bring torch into every worker (~500 MB each), and code
+    typed into ``python -`` cannot be re-imported at all. Python has no switch
+    for this: multiprocessing reads ``sys.modules["__main__"]`` when a process
+    starts, so a bare module stands in for it meanwhile.
+    """
+    main = sys.modules.get("__main__")
+    if main is None or scenario.task.__module__ == "__main__":
+        yield
+        return
+    sys.modules["__main__"] = types.ModuleType("__main__")
+    try:
+        yield
+    finally:
+        sys.modules["__main__"] = main
 
 
 class MazeVectorEnv(gym.vector.VectorEnv):
@@ -168,7 +253,11 @@ class MazeVectorEnv(gym.vector.VectorEnv):
     Args:
       num_envs: how many envs.
       scenario: a registered scenario's name (``mjmaze.registry.names()``).
-      num_workers: worker processes (default: the usable cores, at most ``num_envs``).
+      num_workers: worker processes besides the calling one (default: the usable
+        cores, less one when ``step_in_caller``; at most what the envs need).
+      step_in_caller: the calling process steps an equal share of the envs
+        itself while the workers step theirs, instead of idling until they
+        answer (default). False: every env is in a worker.
       autoreset_mode: ``"next_step"`` (default) or ``"same_step"`` (see the module docstring).
       copy: return a copy of the shared observations (default). ``False`` returns the
         shared array itself, which the next step overwrites: faster, for a loop
@@ -189,6 +278,7 @@ class MazeVectorEnv(gym.vector.VectorEnv):
         num_envs: int,
         scenario: str = suite.DEFAULT_SCENARIO,
         num_workers: int | None = None,
+        step_in_caller: bool = True,
         autoreset_mode: str | AutoresetMode = "next_step",
         copy: bool = True,
         timeout: float = 120.0,
@@ -204,9 +294,11 @@ class MazeVectorEnv(gym.vector.VectorEnv):
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
         usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
-        num_workers = min(num_envs, usable if num_workers is None else num_workers)
-        if num_workers < 1:
-            raise ValueError(f"num_workers must be >= 1, got {num_workers}")
+        if num_workers is None:
+            num_workers = usable - 1 if step_in_caller else usable
+        num_workers = min(num_envs - 1 if step_in_caller else num_envs, num_workers)
+        if num_workers < (0 if step_in_caller else 1):
+            raise ValueError(f"num_workers must be >= {0 if step_in_caller else 1}, got {num_workers}")
 
         # Checks the arguments here, in this process, and tells shapes and info fields.
         probe = suite.make_task(scenario, task_kwargs)
@@ -228,8 +320,11 @@ class MazeVectorEnv(gym.vector.VectorEnv):
         self.closed = False
         self._copy = copy
         self._timeout = float(timeout)
+        # Poll rather than sleep while waiting (see _spin_then_block) when every process (the
+        # workers and this one) has a core.
+        self._spin_seconds = SPIN_SECONDS if num_workers + 1 <= usable else 0.0
         self._steps_taken = 0
-        self._step_seconds = self._wait_seconds = 0.0
+        self._step_seconds = self._wait_seconds = self._local_seconds = 0.0
         self._error: WorkerError | None = None
 
         scalar_dtype = np.dtype(
@@ -245,29 +340,41 @@ class MazeVectorEnv(gym.vector.VectorEnv):
         self._scalars = self._arrays["scalars"]
 
         ctx = mp.get_context(context)
-        self._worker_envs = [ids.tolist() for ids in np.array_split(np.arange(self.num_envs), num_workers)]
+        # The first shares (the larger ones) go to the workers; the last one is the caller's.
+        shares = [ids.tolist() for ids in np.array_split(np.arange(self.num_envs), num_workers + step_in_caller)]
+        self._worker_envs = shares[:num_workers]
+        offsets = [(first + i * num_configs // self.num_envs) % num_configs for i in range(self.num_envs)]
+        same_step = mode == AutoresetMode.SAME_STEP
         self._conns, self._processes = [], []
-        for worker_id, env_ids in enumerate(self._worker_envs):
-            parent_end, child_end = ctx.Pipe()
-            offsets = [(first + i * num_configs // self.num_envs) % num_configs for i in env_ids]
-            process = ctx.Process(
-                target=_worker,
-                name=f"mjmaze-worker-{worker_id}",
-                args=(worker_id, child_end, self._shm.name, layout, env_ids, offsets, registry.get(scenario), task_kwargs,
-                      mode == AutoresetMode.SAME_STEP),
-                daemon=True,
-            )
-            process.start()
-            child_end.close()
-            self._conns.append(parent_end)
-            self._processes.append(process)
+        self._local: _EnvGroup | None = None
+        declaration = registry.get(scenario)
+        with _main_module_hidden(declaration):
+            for worker_id, env_ids in enumerate(self._worker_envs):
+                parent_end, child_end = ctx.Pipe()
+                process = ctx.Process(
+                    target=_worker,
+                    name=f"mjmaze-worker-{worker_id}",
+                    args=(worker_id, child_end, self._shm.name, layout, env_ids, [offsets[i] for i in env_ids],
+                          declaration, task_kwargs, same_step, self._spin_seconds),
+                    daemon=True,
+                )
+                process.start()
+                child_end.close()
+                self._conns.append(parent_end)
+                self._processes.append(process)
         try:
+            if step_in_caller:  # built while the workers build theirs
+                local = shares[-1]
+                self._local = _EnvGroup(self._arrays, local, [offsets[i] for i in local], scenario, task_kwargs, same_step)
             self._collect()  # every worker has built its envs
         except WorkerError as error:
             raise WorkerError(
                 f"{error}\nWorkers are started with {context!r}: a script that makes a vector env must do so "
                 "under `if __name__ == \"__main__\":`, and the worker's own error is printed above."
             ) from None
+        except BaseException:
+            self.close()
+            raise
 
     # -- the gymnasium API ------------------------------------------------
 
@@ -283,15 +390,21 @@ class MazeVectorEnv(gym.vector.VectorEnv):
         if seed is not None:
             self._np_random, self._np_random_seed = seeding.np_random(seeds[0])
         self._send_all("reset", seeds)
+        self._run_local("reset", seeds)
+        self._collect()
         return self._observations(), self._infos()
 
     def step(self, actions):
         self._check_usable()
         started = time.perf_counter()
         self._arrays["actions"][:] = actions
-        sent = time.perf_counter()
         self._send_all("step", None)
-        self._wait_seconds += time.perf_counter() - sent
+        local_started = time.perf_counter()
+        self._run_local("step", None)
+        waiting_started = time.perf_counter()
+        self._collect()
+        self._local_seconds += waiting_started - local_started
+        self._wait_seconds += time.perf_counter() - waiting_started
         self._steps_taken += 1
         scalars = self._scalars
         infos = self._infos()
@@ -314,17 +427,19 @@ class MazeVectorEnv(gym.vector.VectorEnv):
     def timings(self) -> dict[str, float]:
         """Where a step's time went, in microseconds per step, averaged since the start.
 
-        ``step``: one call of :meth:`step`; ``parent``: the calling process's own
-        work in it; ``waiting``: the calling process sending the step and waiting for workers;
-        ``worker_busy``: a worker stepping its envs (mean over workers, resets by
-        :meth:`reset` not counted); the rest
-        of ``waiting`` is workers idling (for each other, or waking up).
+        ``step``: one call of :meth:`step` = ``local`` (the calling process
+        stepping its own envs, 0 with ``step_in_caller=False``) + ``waiting`` (then
+        waiting for the workers) + the rest of the caller's work;
+        ``worker_busy``: a worker stepping its envs (mean over workers, nan without
+        workers; resets by :meth:`reset` not counted). A worker that is busy longer
+        than ``local`` + ``waiting`` cannot be: the difference is its idling (for the
+        others, or waking up).
         """
         steps = max(self._steps_taken, 1)
-        busy = float(np.mean(self._arrays["busy_seconds"])) if self._arrays is not None else float("nan")
+        busy = float(np.mean(self._arrays["busy_seconds"])) if self._arrays is not None and self._conns else float("nan")
         return {
             "step": 1e6 * self._step_seconds / steps,
-            "parent": 1e6 * (self._step_seconds - self._wait_seconds) / steps,
+            "local": 1e6 * self._local_seconds / steps,
             "waiting": 1e6 * self._wait_seconds / steps,
             "worker_busy": 1e6 * busy / steps,
         }
@@ -342,7 +457,8 @@ class MazeVectorEnv(gym.vector.VectorEnv):
             self.close()
 
     def __repr__(self) -> str:
-        return f"MazeVectorEnv({self.scenario!r}, num_envs={self.num_envs}, num_workers={len(self._processes)})"
+        return (f"MazeVectorEnv({self.scenario!r}, num_envs={self.num_envs}, num_workers={len(self._processes)}, "
+                f"step_in_caller={self._local is not None})")
 
     # -- workers ----------------------------------------------------------
 
@@ -364,17 +480,36 @@ class MazeVectorEnv(gym.vector.VectorEnv):
             raise WorkerError("this vector env is closed")
 
     def _send_all(self, command: str, argument) -> None:
+        """Sends a command to every worker; :meth:`_collect` waits for their answers."""
         self._check_usable()
         for worker_id, conn in enumerate(self._conns):
             try:
                 conn.send((command, argument))
             except (BrokenPipeError, ConnectionResetError, OSError):
                 self._fail(worker_id, "its pipe is broken (the process is gone)")
-        self._collect()
+
+    def _run_local(self, command: str, argument) -> None:
+        """The calling process's share of a command; an error in it closes the vector env."""
+        if self._local is None:
+            return
+        try:
+            if command == "step":
+                self._local.step()
+            else:
+                self._local.reset(argument)
+        except BaseException:
+            self.close()
+            raise
 
     def _collect(self) -> None:
         """Waits for every worker's answer; a dead, failing or silent worker raises."""
         pending = dict(enumerate(self._conns))
+        spin_until = time.perf_counter() + self._spin_seconds
+        while pending and time.perf_counter() < spin_until:  # see _spin_then_block
+            for worker_id, conn in list(pending.items()):
+                if conn.poll(0):
+                    self._receive(worker_id, conn)
+                    del pending[worker_id]
         deadline = time.monotonic() + self._timeout
         while pending:
             waitables = list(pending.values()) + [self._processes[w].sentinel for w in pending]
@@ -383,15 +518,19 @@ class MazeVectorEnv(gym.vector.VectorEnv):
                 self._fail(min(pending), f"no answer within {self._timeout:.0f} s")
             for worker_id, conn in list(pending.items()):
                 if conn.poll():
-                    try:
-                        message = conn.recv()
-                    except (EOFError, OSError):
-                        self._fail(worker_id, self._exit_reason(worker_id))
-                    if message is not None:  # ("error", summary, traceback)
-                        self._fail(worker_id, f"{message[1]}\n{message[2]}")
+                    self._receive(worker_id, conn)
                     del pending[worker_id]
                 elif not self._processes[worker_id].is_alive():
                     self._fail(worker_id, self._exit_reason(worker_id))
+
+    def _receive(self, worker_id: int, conn) -> None:
+        """Reads a worker's answer: None, or an error that fails the vector env."""
+        try:
+            message = conn.recv()
+        except (EOFError, OSError):  # the process is gone
+            self._fail(worker_id, self._exit_reason(worker_id))
+        if message is not None:  # ("error", summary, traceback)
+            self._fail(worker_id, f"{message[1]}\n{message[2]}")
 
     def _exit_reason(self, worker_id: int) -> str:
         process = self._processes[worker_id]
@@ -411,6 +550,9 @@ class MazeVectorEnv(gym.vector.VectorEnv):
         raise self._error
 
     def _shutdown(self) -> None:
+        if getattr(self, "_local", None) is not None:
+            self._local.close()
+            self._local = None
         for conn, process in zip(self._conns, self._processes):
             if process.is_alive():
                 try:

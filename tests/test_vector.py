@@ -37,7 +37,8 @@ def test_make_vec_returns_the_shared_memory_vector_env():
     assert len({frame.tobytes() for frame in obs}) == 4  # four different envs
     assert envs.metadata["autoreset_mode"] == gymnasium.vector.AutoresetMode.NEXT_STEP
     timings = envs.timings()  # where the step went
-    assert 0 < timings["worker_busy"] <= timings["waiting"] <= timings["step"]
+    assert 0 < timings["local"] + timings["waiting"] <= timings["step"]
+    assert timings["worker_busy"] > 0
     envs.close()
 
 
@@ -144,7 +145,7 @@ def test_an_exception_in_a_task_names_the_worker_and_the_error():
 def test_a_gl_failure_in_the_workers_is_reported(monkeypatch):
     monkeypatch.delenv("MUJOCO_GL", raising=False)
     monkeypatch.setenv("MUJOCO_EGL_DEVICE_ID", "99")  # EGL is chosen, then cannot start
-    envs = MazeVectorEnv(2, "labyrinth", size=5)
+    envs = MazeVectorEnv(2, "labyrinth", size=5, step_in_caller=False)
     with pytest.raises(WorkerError, match="GLBackendError"):
         envs.reset(seed=0)
 
@@ -167,3 +168,65 @@ def test_bad_arguments_fail_in_the_calling_process():
         MazeVectorEnv(2, "labyrinth", autoreset_mode="disabled")
     with pytest.raises(ValueError, match="unknown scenario"):
         MazeVectorEnv(2, "doom")
+
+
+def test_where_an_env_is_stepped_changes_nothing():
+    def run(**where):
+        envs = MazeVectorEnv(4, "two_colour", complexity=1, **where)
+        frames, _ = envs.reset(seed=7)
+        frames, rewards = [frames], []
+        for actions in np.random.default_rng(1).integers(5, size=(30, 4)):
+            obs, reward, *_ = envs.step(actions)
+            frames.append(obs)
+            rewards.append(reward)
+        envs.close()
+        return np.stack(frames), np.stack(rewards)
+
+    in_workers = run(num_workers=2, step_in_caller=False)
+    shared = run(num_workers=1, step_in_caller=True)  # envs 0-1 in the worker, 2-3 in this process
+    in_caller = run(num_workers=0)
+    for other in (shared, in_caller):
+        assert np.array_equal(in_workers[0], other[0]) and np.array_equal(in_workers[1], other[1])
+
+
+def test_an_exception_in_the_callers_share_closes_the_vector_env():
+    envs = MazeVectorEnv(2, "labyrinth", size=5, num_workers=1)  # env 1 is stepped here
+    envs.reset(seed=0)
+    with pytest.raises(IndexError):
+        envs.step(np.array([0, 7]))  # no action 7 in the default set of 5
+    assert envs.closed and not any(p.is_alive() for p in envs._processes)
+
+
+WORKER_SCRIPT = """
+import os, pathlib, sys
+import numpy as np
+import torch  # what a training script brings
+if __name__ != "__main__":  # re-imported by a worker
+    pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else os.environ["MARKER"]).write_text("imported")
+from mjmaze.vector import MazeVectorEnv
+if __name__ == "__main__":
+    envs = MazeVectorEnv(2, "labyrinth", size=5, step_in_caller=False)
+    envs.reset(seed=0)
+    for process in envs._processes:
+        maps = pathlib.Path(f"/proc/{process.pid}/maps").read_text()
+        print("torch" if "libtorch" in maps else "no torch")
+    envs.close()
+"""
+
+
+def test_workers_do_not_import_the_callers_script_or_torch(tmp_path):
+    pytest.importorskip("torch")
+    import subprocess
+    import sys
+
+    script, marker = tmp_path / "train_like.py", tmp_path / "marker"
+    script.write_text(WORKER_SCRIPT)
+    result = subprocess.run([sys.executable, str(script), str(marker)], capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.split() == ["no", "torch", "no", "torch"]
+    assert not marker.exists()
+    # Typed into `python -`, which spawn could never re-import.
+    result = subprocess.run([sys.executable, "-"], input=WORKER_SCRIPT, capture_output=True, text=True, timeout=300,
+                            env={**os.environ, "MARKER": str(marker)})
+    assert result.returncode == 0, result.stderr
+    assert not marker.exists()

@@ -75,14 +75,17 @@ class MazePhysics(mujoco.Physics):
         qpos, qvel, dt = data.qpos, data.qvel, model.opt.timestep
         if len(self.tic_xy) != nstep:
             self.tic_xy = np.zeros((nstep, 2))
-            self._ahead = np.zeros_like(qpos)
-        ahead, tic_xy = self._ahead, self.tic_xy
+        tic_xy = self.tic_xy
         with self.check_invalid_state():
             for tic in range(nstep):
-                np.multiply(qvel, dt, out=ahead)
-                qpos += ahead
+                # Only x and y matter (the agent is a sphere); plain floats beat
+                # numpy calls on 2-element arrays.
+                ahead_x, ahead_y = qvel[0] * dt, qvel[1] * dt
+                qpos[0] += ahead_x
+                qpos[1] += ahead_y
                 mj.mj_step(model, data)
-                qpos -= ahead
+                qpos[0] -= ahead_x
+                qpos[1] -= ahead_y
                 tic_xy[tic] = qpos[:2]
 
     def agent_pose(self) -> tuple[float, float, float]:
@@ -260,6 +263,18 @@ class MazeTask(base.Task):
         self._steps += 1
         self._reward, self._ended = self.scenario_step(physics, physics.tic_xy)
         self._return += self._reward
+
+    def advance(self, physics: MazePhysics, action) -> tuple[float, bool, bool]:
+        """One agent step without a dm_control ``TimeStep``: ``(reward, terminated, truncated)``.
+
+        The sequence of ``control.Environment.step`` (before the step, its tics,
+        after it), for the vector env's lean path; render the frame with
+        :meth:`get_observation`. Call it only within an episode.
+        """
+        self.before_step(action, physics)
+        physics.step(TICS_PER_STEP)
+        self.after_step(physics)
+        return self._reward, self._ended, not self._ended and self._steps >= EPISODE_STEPS
 
     def get_observation(self, physics: MazePhysics) -> collections.OrderedDict:
         self._bind(physics)
