@@ -49,8 +49,8 @@ from gymnasium.vector.utils import batch_space
 from mjmaze import registry, suite
 
 SHARED_MEMORY_PREFIX = "mjmaze_"
-# How long a waiting process polls before it sleeps (see _spin_then_block).
-SPIN_SECONDS = 0.002
+# How long a waiting process polls before it sleeps by default (see _spin_then_block).
+POLL_SECONDS = 0.002
 AUTORESET_MODES = {"next_step": AutoresetMode.NEXT_STEP, "same_step": AutoresetMode.SAME_STEP}
 
 
@@ -258,6 +258,11 @@ class MazeVectorEnv(gym.vector.VectorEnv):
       step_in_caller: the calling process steps an equal share of the envs
         itself while the workers step theirs, instead of idling until they
         answer (default). False: every env is in a worker.
+      poll_seconds: how long a waiting process (a worker waiting for the next
+        step, the caller waiting for the workers) polls before it sleeps; waking
+        from sleep costs time (see ``_spin_then_block``), polling costs a core.
+        Default: 2 ms when every process has a core of its own, else 0. Pass 0
+        when the caller computes between steps (a network acting on the frames).
       autoreset_mode: ``"next_step"`` (default) or ``"same_step"`` (see the module docstring).
       copy: return a copy of the shared observations (default). ``False`` returns the
         shared array itself, which the next step overwrites: faster, for a loop
@@ -279,6 +284,7 @@ class MazeVectorEnv(gym.vector.VectorEnv):
         scenario: str = suite.DEFAULT_SCENARIO,
         num_workers: int | None = None,
         step_in_caller: bool = True,
+        poll_seconds: float | None = None,
         autoreset_mode: str | AutoresetMode = "next_step",
         copy: bool = True,
         timeout: float = 120.0,
@@ -320,9 +326,9 @@ class MazeVectorEnv(gym.vector.VectorEnv):
         self.closed = False
         self._copy = copy
         self._timeout = float(timeout)
-        # Poll rather than sleep while waiting (see _spin_then_block) when every process (the
-        # workers and this one) has a core.
-        self._spin_seconds = SPIN_SECONDS if num_workers + 1 <= usable else 0.0
+        if poll_seconds is None:  # poll only when every process (the workers and this one) has a core
+            poll_seconds = POLL_SECONDS if num_workers + 1 <= usable else 0.0
+        self._spin_seconds = float(poll_seconds)
         self._steps_taken = 0
         self._step_seconds = self._wait_seconds = self._local_seconds = 0.0
         self._error: WorkerError | None = None

@@ -65,6 +65,35 @@ def tiny(tmp_path, **overrides):
     return run_settings.Args(**settings)
 
 
+def test_the_rollouts_own_graph_gives_the_gradients_of_a_recomputed_unroll():
+    # Training keeps the graph of the rollout's forward passes for the update;
+    # the loss and gradients must be those of recomputing the rollout at once.
+    torch.manual_seed(0)
+    agent = Agent(5)
+    steps, batch = 6, 3
+    frames = torch.randint(0, 256, (steps, batch, 64, 112, 3), dtype=torch.uint8)
+    starts = torch.zeros(steps, batch, dtype=torch.bool)
+    starts[0] = starts[3, 1] = True  # an episode starts mid-rollout in env 1
+    actions = torch.randint(0, 5, (steps, batch))
+    returns = torch.randn(steps, batch)
+
+    def gradients(logits, values):
+        agent.zero_grad()
+        a2c.a2c_losses(logits, values, actions, returns, 0.5, 0.001)["total"].backward()
+        return [p.grad.clone() for p in agent.parameters()]
+
+    hidden, kept_logits, kept_values = agent.initial_state(batch), [], []
+    for t in range(steps):  # as the rollout does: one step at a time
+        logits, value, hidden = agent.step(agent.features(frames[t]), hidden, starts[t])
+        kept_logits.append(logits)
+        kept_values.append(value)
+    kept = gradients(torch.stack(kept_logits), torch.stack(kept_values))
+    logits, values, _, _ = agent.unroll(frames, agent.initial_state(batch), starts)
+    recomputed = gradients(logits, values)
+    for a, b in zip(kept, recomputed):
+        assert torch.allclose(a, b, rtol=1e-4, atol=1e-6)
+
+
 def test_two_update_smoke_run_writes_a_run_folder(tmp_path):
     run = a2c.train(tiny(tmp_path, total_steps=32))
     assert json.loads((run / "config.json").read_text())["size"] == 5
