@@ -1,28 +1,38 @@
 """Multi-process throughput: mjmaze's vector env against the raw render path and ViZDoom.
 
-    python bench/multiproc.py [--seconds 4] [--rounds 3]
+    python bench/multiproc.py [--seconds 4] [--rounds 3] [--baseline REV]
 
 Prints, alternating the sides in rounds so machine drift hits all of them:
-  (a) mjmaze   MazeVectorEnv, 16 envs, Labyrinth 9x9, random actions, resets included
-  (b) raw      the lean loop (4 x mj_step + render) in one process per core
+  (a) mjmaze   MazeVectorEnv, 16 envs, Labyrinth 9x9, default frames, random actions,
+               resets included, default settings (the caller steps a share)
+  (b) raw      the lean loop in one process per core: a random action's velocity,
+               mj_step(model, data, 4), render (no rules, no per-tic contacts, no resets)
   (c) vizdoom  ViZDoom my_way_home.cfg, 160x120 RGB (its smallest), make_action(a, 4),
                one process per core (skipped with a note when vizdoom is absent)
-then the ratios mjmaze/raw and mjmaze/ViZDoom, and (d) scaling: obs/s for
-sizes 5, 9, 13 and for num_envs 1, 4, 16, 64, with peak RSS per worker and per env.
+  (e) with --baseline REV: (a) from that git revision (bench/baseline.py)
+then the ratios mjmaze/raw and mjmaze/ViZDoom, (d) scaling: obs/s for sizes 5, 9,
+13 and for num_envs 1, 4, 16, 64, with peak RSS per worker and per env, and (f)
+every registered scenario at its default difficulty, 16 envs.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import json
 import multiprocessing as mp
 import os
 import statistics
+import subprocess
+import sys
 import tempfile
 import time
 
 import numpy as np
 
+import baseline
 import mjmaze
+from mjmaze import registry
 from mjmaze.vector import MazeVectorEnv
 
 CORES = len(os.sched_getaffinity(0))
@@ -36,9 +46,13 @@ def _peak_rss_mb(pid: int) -> float:
     return float("nan")
 
 
-def bench_vector(num_envs: int, size: int, seconds: float, timings: dict | None = None) -> tuple[float, float]:
-    """obs/s of the vector env and the peak RSS of its largest worker (MB); fills ``timings`` if given."""
-    envs = MazeVectorEnv(num_envs, "labyrinth", size=size, copy=False)
+def bench_vector(num_envs: int, size: int | None, seconds: float, timings: dict | None = None,
+                 scenario: str = "labyrinth") -> tuple[float, float]:
+    """obs/s of the vector env and the peak RSS of its largest worker (MB); fills ``timings`` if given.
+
+    ``size`` None: the scenario's default difficulty.
+    """
+    envs = MazeVectorEnv(num_envs, scenario, copy=False, **({} if size is None else {"size": size}))
     rng = np.random.default_rng(0)
     envs.reset(seed=0)
     for _ in range(5):  # warm up
@@ -48,7 +62,7 @@ def bench_vector(num_envs: int, size: int, seconds: float, timings: dict | None 
         envs.step(rng.integers(5, size=num_envs))
         steps += 1
     rate = steps * num_envs / (time.perf_counter() - start)
-    rss = max(_peak_rss_mb(p.pid) for p in envs._processes)
+    rss = max([_peak_rss_mb(p.pid) for p in envs._processes] + [_peak_rss_mb(os.getpid())])
     if timings is not None:
         timings.update(envs.timings())
     envs.close()
@@ -61,11 +75,14 @@ def _raw_process(barrier, seconds, size, results):
     env = mjmaze.load("labyrinth", task_kwargs={"size": size, "random": os.getpid()})
     env.reset()
     model, data, renderer = env.physics.model.ptr, env.physics.data.ptr, env.task._renderer
-    velocities = np.random.default_rng(os.getpid()).uniform(-2, 2, (4096, 3))
+    task, physics = env.task, env.physics
+    actions = np.random.default_rng(os.getpid()).integers(5, size=4096)
     barrier.wait()
     frames, start = 0, time.perf_counter()
     while time.perf_counter() - start < seconds:
-        data.qvel[:3] = velocities[frames % 4096]
+        # Moved as random actions move the agent, so the views (and the render
+        # cost) are those of the vector env's; no rules, no per-tic contacts.
+        task.before_step(actions[frames % 4096], physics)
         mujoco.mj_step(model, data, 4)
         renderer.render(data)
         frames += 1
@@ -117,7 +134,26 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=4.0, help="measuring time per side and round")
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--no-scaling", action="store_true")
+    parser.add_argument("--baseline", default=None, help="a git revision whose vector env to measure beside (e.g. HEAD~3)")
+    parser.add_argument("--vector-only", type=float, default=None, help=argparse.SUPPRESS)  # one (a), as JSON
     args = parser.parse_args()
+    if args.vector_only is not None:
+        print(json.dumps(bench_vector(16, 9, args.vector_only)[0]))
+        return
+    with baseline.checkout(args.baseline) if args.baseline else contextlib.nullcontext() as old:
+        _compare(args, old)
+    if not args.no_scaling:
+        _scaling(args)
+
+
+def _baseline_vector(checkout, seconds: float) -> float:
+    """(a) from another revision: this script, run with that revision's mjmaze."""
+    result = subprocess.run([sys.executable, __file__, "--vector-only", str(seconds)], check=True, capture_output=True,
+                            text=True, env=baseline.environment(checkout))
+    return float(result.stdout.strip().splitlines()[-1])
+
+
+def _compare(args, old) -> None:
     try:
         import vizdoom  # noqa: F401
 
@@ -128,13 +164,21 @@ def main() -> None:
     rates: dict[str, list[float]] = {"mjmaze (16 envs)": [], f"raw ({CORES} procs)": []}
     if have_vizdoom:
         rates[f"vizdoom ({CORES} procs)"] = []
+    if old is not None:
+        rates[f"mjmaze {args.baseline}"] = []
     phases: list[dict] = []
-    for _ in range(args.rounds):
-        phases.append({})
-        rates["mjmaze (16 envs)"].append(bench_vector(16, 9, args.seconds, phases[-1])[0])
-        rates[f"raw ({CORES} procs)"].append(bench_processes(_raw_process, args.seconds))
-        if have_vizdoom:
-            rates[f"vizdoom ({CORES} procs)"].append(bench_processes(_vizdoom_process, args.seconds))
+    for round_ in range(args.rounds):
+        sides = list(rates)
+        for side in sides if round_ % 2 == 0 else reversed(sides):
+            if side == "mjmaze (16 envs)":
+                phases.append({})
+                rates[side].append(bench_vector(16, 9, args.seconds, phases[-1])[0])
+            elif side.startswith("raw"):
+                rates[side].append(bench_processes(_raw_process, args.seconds))
+            elif side.startswith("vizdoom"):
+                rates[side].append(bench_processes(_vizdoom_process, args.seconds))
+            else:
+                rates[side].append(_baseline_vector(old, args.seconds))
     median = {name: statistics.median(values) for name, values in rates.items()}
     print(f"Labyrinth 9x9 vs ViZDoom my_way_home, {CORES} cores, {args.rounds} rounds x {args.seconds:.0f} s (median, min-max)")
     for name, values in rates.items():
@@ -145,13 +189,16 @@ def main() -> None:
         print(f"  ratio mjmaze / ViZDoom : {mjmaze_rate / median[f'vizdoom ({CORES} procs)']:.2f}")
     else:
         print("  ViZDoom skipped: `pip install -e .[bench]` (the vizdoom package) to compare.")
+    if old is not None:
+        print(f"  ratio mjmaze / mjmaze {args.baseline} : {mjmaze_rate / median[f'mjmaze {args.baseline}']:.2f}")
     step = {key: statistics.median(p[key] for p in phases) for key in phases[0]}
-    print(f"  mjmaze step by phase (us per step of 16 envs): step {step['step']:.0f} = parent's own work "
-          f"{step['parent']:.0f} + sending/waiting {step['waiting']:.0f}; a worker is busy {step['worker_busy']:.0f} "
-          f"of it ({step['worker_busy'] / 8:.0f} per env), idle {step['waiting'] - step['worker_busy']:.0f}")
+    envs_per_worker = 16 // CORES
+    print(f"  mjmaze step by phase (us per step of 16 envs): step {step['step']:.0f} = this process stepping its "
+          f"envs {step['local']:.0f} + then waiting {step['waiting']:.0f} + the rest {step['step'] - step['local'] - step['waiting']:.0f}; "
+          f"a worker is busy {step['worker_busy']:.0f} ({step['worker_busy'] / envs_per_worker:.0f} per env)")
 
-    if args.no_scaling:
-        return
+
+def _scaling(args) -> None:
     print("Scaling (MazeVectorEnv, copy=False):")
     by_size = {size: bench_vector(16, size, args.seconds)[0] for size in (5, 9, 13)}
     for size, rate in by_size.items():
@@ -159,8 +206,12 @@ def main() -> None:
     for num_envs in (1, 4, 16, 64):
         rate, rss = bench_vector(num_envs, 9, args.seconds)
         per_worker = -(-num_envs // min(num_envs, CORES))
-        print(f"  size  9, {num_envs:>2} envs : {rate:8.0f} obs/s   peak RSS {rss:6.0f} MB per worker, "
+        print(f"  size  9, {num_envs:>2} envs : {rate:8.0f} obs/s   peak RSS {rss:6.0f} MB per process, "
               f"{rss / per_worker:6.1f} MB per env")
+    print("Every scenario at its default difficulty (16 envs):")
+    rates = {name: bench_vector(16, None, args.seconds, scenario=name)[0] for name in registry.names()}
+    for name, rate in rates.items():
+        print(f"  {name:<12} {rate:8.0f} obs/s   {rate / rates['labyrinth']:.2f}x Labyrinth's")
 
 
 if __name__ == "__main__":

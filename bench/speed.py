@@ -5,7 +5,9 @@
 Prints obs/s for, alternating in rounds so machine drift hits every side, each
 in the default "textured" frames and in the "flat" ones:
   render      mjv_updateScene + mjr_render + mjr_readPixels alone (the agent moving)
-  raw         the lean loop: mj_step(model, data, 4) + the render path
+  raw         the lean loop: random actions' velocities, mj_step(model, data, 4) + the render path
+  lean        the vector env's per-env step: MazeTask.advance (action -> physics -> rules), the
+              render into a preallocated frame and the info dict, no dm_control TimeStep
   dm_control  env.step(action) of mjmaze.load("labyrinth"): action -> physics -> rules -> observation copy
   gymnasium   env.step(action) of gymnasium.make("mjmaze/Labyrinth-v0") (through its default wrappers)
 and the ratios full step / raw, textured / flat, plus a per-phase split of the full step.
@@ -48,15 +50,35 @@ def bench_render(size: int, steps: int, style: str) -> float:
 
 def bench_raw(size: int, steps: int, style: str) -> float:
     env, model, data, renderer = _lean_setup(size, style)
-    rng = np.random.default_rng(0)
-    velocities = rng.uniform(-2, 2, (steps, 3))
+    actions = np.random.default_rng(0).integers(5, size=steps)
+    task, physics = env.task, env.physics
     start = time.perf_counter()
-    for velocity in velocities:
-        data.qvel[:3] = velocity
+    for action in actions:
+        # The agent moves as the actions move it (so the views, and the render
+        # cost, are those of the other sides), without rules or per-tic contacts.
+        task.before_step(action, physics)
         mujoco.mj_step(model, data, 4)
         renderer.render(data)
     rate = steps / (time.perf_counter() - start)
     env.task.close()
+    return rate
+
+
+def bench_lean(size: int, steps: int, style: str) -> float:
+    env = mjmaze.load("labyrinth", task_kwargs={"size": size, "random": 0, "visual_style": style})
+    task, physics = env.task, env.physics
+    task.observation_buffer = np.empty(task.observation_spec(physics)["pixels"].shape, np.uint8)
+    actions = np.random.default_rng(0).integers(5, size=steps)
+    env.reset()
+    start = time.perf_counter()
+    for action in actions:
+        _, terminated, truncated = task.advance(physics, action)
+        task.get_observation(physics)
+        task.get_info(physics)
+        if terminated or truncated:
+            env.reset()
+    rate = steps / (time.perf_counter() - start)
+    task.close()
     return rate
 
 
@@ -122,7 +144,8 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=5)
     args = parser.parse_args()
 
-    benches = {"render": bench_render, "raw": bench_raw, "dm_control": bench_dm_control, "gymnasium": bench_gymnasium}
+    benches = {"render": bench_render, "raw": bench_raw, "lean": bench_lean, "dm_control": bench_dm_control,
+               "gymnasium": bench_gymnasium}
     sides = [(name, style) for name in benches for style in mjcf.VISUAL_STYLES]
     rates: dict[tuple[str, str], list[float]] = {side: [] for side in sides}
     for round_ in range(args.rounds):
@@ -136,7 +159,8 @@ def main() -> None:
     for (name, style), values in rates.items():
         print(f"  {name:<11} {style:<9} {median[name, style]:8.0f} obs/s   ({min(values):.0f}-{max(values):.0f})")
     for style in mjcf.VISUAL_STYLES:
-        print(f"  {style:<9} ratio dm_control / raw : {median['dm_control', style] / median['raw', style]:.2f}, "
+        print(f"  {style:<9} ratio lean / raw : {median['lean', style] / median['raw', style]:.2f}, "
+              f"dm_control / raw : {median['dm_control', style] / median['raw', style]:.2f}, "
               f"gymnasium / raw : {median['gymnasium', style] / median['raw', style]:.2f}")
     for name in benches:
         # Time per step, textured over flat (the fidelity budget: dm_control <= 1.25).

@@ -1,30 +1,37 @@
-"""Training throughput of the A2C baseline, with the network-only and env-only figures beside it.
+"""Training throughput of the A2C baseline, side by side with another revision.
 
-    python bench/train_speed.py [--updates 12] [--device auto]
+    python bench/train_speed.py [--updates 12] [--rounds 3] [--baseline REV] [--device auto]
 
-  env only      MazeVectorEnv, 16 envs, Labyrinth 5x5, random actions
-  network only  one update's worth of network work on random frames: 128 inference
-                steps of 16 frames, then the forward + backward pass over 2048 frames
-  training      python -m mjmaze.train.a2c on Labyrinth 5x5 (16 envs x 128 steps), median
-                over the updates after the first two
+  env only      MazeVectorEnv, 16 envs, Labyrinth 5x5, random actions, as training makes it
+  network only  one update's network work on random frames, as training does it: 128
+                steps of 16 frames (the graph kept), then the backward pass and the step
+  training      `python -m mjmaze.train.a2c` on Labyrinth 5x5 (16 envs x 128 steps): the
+                median obs/s of the updates after the first two. With --baseline, the
+                same command from that revision (a git worktree; bench/baseline.py), the
+                two sides alternating in rounds so machine drift hits both.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import pathlib
 import statistics
+import subprocess
+import sys
 import tempfile
 import time
 
 import numpy as np
 import torch
+from torch.nn import functional as F
 
-from mjmaze.vector import MazeVectorEnv
-from mjmaze.train import settings as run_settings
+import baseline
 from mjmaze.train import a2c
+from mjmaze.train import settings as run_settings
 from mjmaze.train.model import Agent
+from mjmaze.vector import MazeVectorEnv
 
 NUM_ENVS, NUM_STEPS = 16, 128
 
@@ -43,6 +50,7 @@ def env_only(seconds: float = 6.0) -> float:
 
 
 def network_only(device: torch.device, repeats: int = 3) -> float:
+    rollout_threads, update_threads = a2c._cpu_threads(run_settings.Args(), device)
     agent = Agent(5).to(device)
     optimizer = torch.optim.RMSprop(agent.parameters(), lr=7e-4, alpha=0.99)
     frames = torch.randint(0, 256, (NUM_STEPS, NUM_ENVS, 64, 112, 3), dtype=torch.uint8)
@@ -52,12 +60,16 @@ def network_only(device: torch.device, repeats: int = 3) -> float:
         if device.type == "cuda":
             torch.cuda.synchronize()
         start = time.perf_counter()
-        hidden = agent.initial_state(NUM_ENVS, device)
-        with torch.no_grad():
-            for t in range(NUM_STEPS):
-                logits, _, hidden = agent.step(agent.features(frames[t].to(device)), hidden, starts[t])
-                torch.distributions.Categorical(logits=logits).sample().cpu()
-        logits, values, _, _ = agent.unroll(frames.to(device), agent.initial_state(NUM_ENVS, device), starts)
+        torch.set_num_threads(rollout_threads)
+        hidden, logits, values = agent.initial_state(NUM_ENVS, device), [], []
+        for t in range(NUM_STEPS):
+            step_logits, value, hidden = agent.step(agent.features(frames[t].to(device)), hidden, starts[t])
+            logits.append(step_logits)
+            values.append(value)
+            with torch.no_grad():
+                torch.multinomial(F.softmax(step_logits, dim=-1), 1).cpu()
+        torch.set_num_threads(update_threads)
+        logits, values = torch.stack(logits), torch.stack(values)
         loss = a2c.a2c_losses(logits, values, logits.argmax(-1), values.detach() + 1, 0.5, 0.001)["total"]
         optimizer.zero_grad()
         loss.backward()
@@ -68,25 +80,42 @@ def network_only(device: torch.device, repeats: int = 3) -> float:
     return statistics.median(rates[1:])  # the first pass warms up
 
 
-def training(updates: int, device: str) -> float:
+def training(updates: int, device: str, checkout: pathlib.Path | None = None) -> float:
+    """Median obs/s of a short training run, from this checkout or from ``checkout``."""
     with tempfile.TemporaryDirectory() as runs:
-        args = run_settings.Args(scenario="labyrinth", size=5, total_steps=updates * NUM_ENVS * NUM_STEPS, runs_dir=runs,
-                        run_name="bench", progress=False, device=device, checkpoint_every=10**12)
-        run = a2c.train(args)
-        sps = [json.loads(line)["sps"] for line in (pathlib.Path(run) / "metrics.jsonl").read_text().splitlines()]
-    return statistics.median(sps[2:])
+        command = [
+            sys.executable, "-m", "mjmaze.train.a2c", "--scenario", "labyrinth", "--size", "5",
+            "--total-steps", str(updates * NUM_ENVS * NUM_STEPS), "--runs-dir", runs, "--run-name", "bench",
+            "--no-progress", "--device", device, "--checkpoint-every", str(10**12),
+        ]
+        subprocess.run(command, check=True, cwd=runs, env=baseline.environment(checkout), stdout=subprocess.DEVNULL)
+        lines = (pathlib.Path(runs) / "bench" / "metrics.jsonl").read_text().splitlines()
+    return statistics.median(json.loads(line)["sps"] for line in lines[2:])
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--updates", type=int, default=12)
+    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--baseline", default=None, help="a git revision to compare with (e.g. HEAD~3)")
     parser.add_argument("--device", default="auto")
     args = parser.parse_args()
     device = run_settings.pick_device(args.device)
     print(f"A2C on Labyrinth 5x5, 16 envs x 128 steps, device {device}, {torch.get_num_threads()} torch threads")
     print(f"  env only      {env_only():8.0f} obs/s")
     print(f"  network only  {network_only(device):8.0f} obs/s")
-    print(f"  training      {training(args.updates, args.device):8.0f} obs/s")
+    with baseline.checkout(args.baseline) if args.baseline else contextlib.nullcontext() as old:
+        sides = {"this checkout": None} | ({f"baseline {args.baseline}": old} if args.baseline else {})
+        rates: dict[str, list[float]] = {name: [] for name in sides}
+        for round_ in range(args.rounds):
+            for name, checkout in (sides.items() if round_ % 2 == 0 else reversed(sides.items())):
+                rates[name].append(training(args.updates, args.device, checkout))
+    for name, values in rates.items():
+        print(f"  training, {name:<24} {statistics.median(values):8.0f} obs/s   "
+              f"({', '.join(f'{v:.0f}' for v in values)})")
+    if args.baseline:
+        new, old = (statistics.median(v) for v in rates.values())
+        print(f"  ratio this / baseline: {new / old:.2f}")
 
 
 if __name__ == "__main__":

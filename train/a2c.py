@@ -146,6 +146,7 @@ def _loop(args, make_envs, envs, agent, optimizer, device, run_dir, step, update
             start_time = time.perf_counter()
             finished = []  # final infos of the episodes that ended in this rollout
             step_logits, step_values = [], []
+            env_seconds = 0.0  # of the rollout, in envs.step
             torch.set_num_threads(rollout_threads)
             try:
                 for t in range(T):
@@ -159,7 +160,9 @@ def _loop(args, make_envs, envs, agent, optimizer, device, run_dir, step, update
                     step_values.append(value)
                     with torch.no_grad():
                         action = torch.multinomial(F.softmax(logits, dim=-1), 1).squeeze(1)
+                    env_started = time.perf_counter()
                     obs, reward, terminated, truncated, infos = envs.step(action.cpu().numpy())
+                    env_seconds += time.perf_counter() - env_started
                     ended = terminated | truncated
                     actions[t] = action.cpu()
                     rewards[t] = torch.from_numpy(reward)
@@ -188,6 +191,7 @@ def _loop(args, make_envs, envs, agent, optimizer, device, run_dir, step, update
                 episode_starts = torch.ones(n, dtype=torch.bool)
                 continue
             failures = 0
+            update_started = time.perf_counter()
             with torch.no_grad():
                 features = agent.features(torch.from_numpy(obs).to(device))
                 _, last_value, _ = agent.step(features, hidden, episode_starts.to(device))
@@ -204,9 +208,13 @@ def _loop(args, make_envs, envs, agent, optimizer, device, run_dir, step, update
 
             step += n * T
             update += 1
-            sps = n * T / (time.perf_counter() - start_time)
+            now = time.perf_counter()
+            sps = n * T / (now - start_time)
             record = {
                 "step": step, "update": update, "sps": sps,
+                # Where the update's time went: stepping the envs, the rest of the rollout, the update itself.
+                "env_seconds": env_seconds, "rollout_seconds": update_started - start_time,
+                "update_seconds": now - update_started,
                 "policy_loss": losses["policy"].item(), "value_loss": losses["value"].item(),
                 "entropy": losses["entropy"].item(), "grad_norm": float(grad_norm), "episodes": len(finished),
                 "env_rebuilds": rebuilds,
