@@ -155,10 +155,10 @@ class TwoColour(base.MazeTask):
 
     def scenario_step(self, physics: base.MazePhysics, path) -> tuple[float, bool]:
         reward = 0.0
-        active = np.flatnonzero(self.item_active)
-        tics = base.reached(self.item_xy[active], path)
+        tics = np.where(self.item_active, base.reached(self.item_xy, path), -1)
+        picked = np.flatnonzero(tics >= 0)
         # Items in the order the agent reached them (Doom tests every tic).
-        for k in active[tics >= 0][np.argsort(tics[tics >= 0], kind="stable")]:
+        for k in picked[np.argsort(tics[picked], kind="stable")]:
             self.item_active[k] = False
             physics.show_objects(self._item_geoms[k], False)
             if self.item_green[k] == self.totem_green:
