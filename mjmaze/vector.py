@@ -3,8 +3,10 @@
 Each worker steps its share of the envs in turn and renders straight into one
 shared-memory array of observations ``(N, H, W, 3)``; rewards, flags and the
 ``info`` fields travel through shared memory too, so a step sends a few bytes
-per worker over a pipe and pickles no frame. Every worker has one GL context
-for all its envs (faster than one per env: see ``bench/gl_contexts.py``).
+per worker over a pipe and pickles no frame. By default the calling process
+steps a share too, while it would otherwise wait (one process fewer per core).
+Every process has one GL context for all its envs (faster than one per env: see
+``bench/gl_contexts.py``).
 
 Reached the standard way::
 

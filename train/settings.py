@@ -46,11 +46,11 @@ class _RunSettings:
     seed: int = 0
     """seed of the envs and the network"""
     num_workers: int | None = None
-    """env worker processes (None: the usable cores)"""
+    """env worker processes beside the training process, which steps a share of the envs too (None: the usable cores less one)"""
     device: str = "auto"
     """auto (CUDA when available), cpu or cuda"""
     torch_threads: int | None = None
-    """CPU threads for the network (None: PyTorch's default)"""
+    """CPU threads for the network's update (None: PyTorch's default); on CPU the rollout uses one"""
     run_name: str | None = None
     """folder under runs_dir (None: <scenario>_<difficulty>_s<seed>)"""
     runs_dir: str = "runs"

@@ -9,7 +9,7 @@
 
 Each run is a Ray task (local Ray by default; ``--address`` joins a cluster,
 whose nodes need mjmaze installed and a shared ``--sweeps-dir``) holding
-``--cpus-per-run`` CPUs (its env workers) and ``--gpus-per-run`` of a GPU.
+``--cpus-per-run`` CPUs (the training process and its env workers) and ``--gpus-per-run`` of a GPU.
 Everything lands in ``sweeps/<name>/``: ``sweep.json`` (the grid and flags) and
 one run folder per run, laid out as ``mjmaze.train.a2c`` does, with ``eval.json``
 (``mjmaze.train.evaluate``) written as the run ends.
@@ -183,7 +183,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--device", default="auto", help="auto (CUDA where Ray gives the task a GPU), cpu, cuda")
     parser.add_argument("--address", default=None, help="an existing Ray cluster ('auto' or host:port)")
     parser.add_argument("--num-cpus", type=int, default=None, help="local Ray: CPUs to use (default: all)")
-    parser.add_argument("--cpus-per-run", type=int, default=2, help="CPUs per run (its env workers)")
+    parser.add_argument("--cpus-per-run", type=int, default=2, help="CPUs per run (the training process and its env workers, at least 1)")
     parser.add_argument("--gpus-per-run", type=float, default=0.0, help="fraction of a GPU per run")
     parser.add_argument("--retries", type=int, default=1, help="Ray retries of a run whose worker died")
     parser.add_argument("--eval-envs", type=int, default=16, help="parallel envs for the evaluation")
@@ -198,7 +198,8 @@ def main(argv: list[str] | None = None) -> None:
     settings = {
         "total_steps": total_steps, "num_envs": args.num_envs, "num_steps": args.num_steps, "device": args.device,
         "checkpoint_every": args.checkpoint_every or max(args.num_envs * args.num_steps, total_steps // 20),
-        "num_workers": args.cpus_per_run, "torch_threads": args.cpus_per_run,
+        # The training process steps a share of the envs itself: one worker fewer than the run's CPUs.
+        "num_workers": args.cpus_per_run - 1, "torch_threads": args.cpus_per_run,
     }
     try:
         for spec in specs:
