@@ -98,11 +98,19 @@ class MazePhysics(mujoco.Physics):
         self.data.qvel[:3] = 0.0
 
     def object_ids(self, names: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
-        """``(mocap ids, geom ids)`` of scenario objects (see :class:`mjmaze.mjcf.ObjectGeom`)."""
-        model = self.model.ptr
-        bodies = [mj.mj_name2id(model, mj.mjtObj.mjOBJ_BODY, name) for name in names]
-        geoms = [mj.mj_name2id(model, mj.mjtObj.mjOBJ_GEOM, name) for name in names]
-        return model.body_mocapid[bodies].copy(), np.array(geoms, dtype=int)
+        """``(mocap ids, geom ids)`` of scenario objects (see :class:`mjmaze.mjcf.ObjectGeom`).
+
+        Looked up once per list of names (Two-colour asks for 91 at every reset).
+        """
+        key = tuple(names)
+        cache = self.__dict__.setdefault("_object_ids", {})
+        if key not in cache:
+            model = self.model.ptr
+            bodies = [mj.mj_name2id(model, mj.mjtObj.mjOBJ_BODY, name) for name in names]
+            geoms = [mj.mj_name2id(model, mj.mjtObj.mjOBJ_GEOM, name) for name in names]
+            cache[key] = model.body_mocapid[bodies].copy(), np.array(geoms, dtype=int)
+        mocap_ids, geom_ids = cache[key]
+        return mocap_ids.copy(), geom_ids.copy()
 
     def place_objects(self, mocap_ids, xy) -> None:
         """Moves objects to floor positions ``xy`` (shape ``(n, 2)`` or ``(2,)``)."""
