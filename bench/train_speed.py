@@ -1,11 +1,12 @@
 """Training throughput of the A2C baseline, side by side with another revision.
 
-    python bench/train_speed.py [--updates 12] [--rounds 3] [--baseline REV] [--device auto]
+    python bench/train_speed.py [--updates 12] [--rounds 3] [--baseline REV] [--device auto] [--scenario NAME]
 
   env only      MazeVectorEnv, 16 envs, Labyrinth 5x5, random actions, as training makes it
   network only  one update's network work on random frames, as training does it: 128
                 steps of 16 frames (the graph kept), then the backward pass and the step
-  training      `python -m mjmaze.train.a2c` on Labyrinth 5x5 (16 envs x 128 steps): the
+  training      `python -m mjmaze.train.a2c` on Labyrinth 5x5 (16 envs x 128 steps; --scenario:
+                another scenario at its default difficulty instead): the
                 median obs/s of the updates after the first two. With --baseline, the
                 same command from that revision (a git worktree; bench/baseline.py), the
                 two sides alternating in rounds so machine drift hits both.
@@ -80,11 +81,12 @@ def network_only(device: torch.device, repeats: int = 3) -> float:
     return statistics.median(rates[1:])  # the first pass warms up
 
 
-def training(updates: int, device: str, checkout: pathlib.Path | None = None) -> float:
+def training(updates: int, device: str, checkout: pathlib.Path | None = None, scenario: str = "labyrinth") -> float:
     """Median obs/s of a short training run, from this checkout or from ``checkout``."""
+    difficulty = ["--size", "5"] if scenario == "labyrinth" else []
     with tempfile.TemporaryDirectory() as runs:
         command = [
-            sys.executable, "-m", "mjmaze.train.a2c", "--scenario", "labyrinth", "--size", "5",
+            sys.executable, "-m", "mjmaze.train.a2c", "--scenario", scenario, *difficulty,
             "--total-steps", str(updates * NUM_ENVS * NUM_STEPS), "--runs-dir", runs, "--run-name", "bench",
             "--no-progress", "--device", device, "--checkpoint-every", str(10**12),
         ]
@@ -99,6 +101,7 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--baseline", default=None, help="a git revision to compare with (e.g. HEAD~3)")
     parser.add_argument("--device", default="auto")
+    parser.add_argument("--scenario", default="labyrinth", help="the training side's scenario (default: labyrinth 5x5)")
     args = parser.parse_args()
     device = run_settings.pick_device(args.device)
     print(f"A2C on Labyrinth 5x5, 16 envs x 128 steps, device {device}, {torch.get_num_threads()} torch threads")
@@ -109,9 +112,9 @@ def main() -> None:
         rates: dict[str, list[float]] = {name: [] for name in sides}
         for round_ in range(args.rounds):
             for name, checkout in (sides.items() if round_ % 2 == 0 else reversed(sides.items())):
-                rates[name].append(training(args.updates, args.device, checkout))
+                rates[name].append(training(args.updates, args.device, checkout, args.scenario))
     for name, values in rates.items():
-        print(f"  training, {name:<24} {statistics.median(values):8.0f} obs/s   "
+        print(f"  training {args.scenario}, {name:<24} {statistics.median(values):8.0f} obs/s   "
               f"({', '.join(f'{v:.0f}' for v in values)})")
     if args.baseline:
         new, old = (statistics.median(v) for v in rates.values())

@@ -328,6 +328,8 @@ class MazeVectorEnv(gym.vector.VectorEnv):
         self.closed = False
         self._copy = copy
         self._timeout = float(timeout)
+        if poll_seconds is not None and not poll_seconds >= 0:
+            raise ValueError(f"poll_seconds must be >= 0 (or None for the default), got {poll_seconds!r}")
         if poll_seconds is None:  # poll only when every process (the workers and this one) has a core
             poll_seconds = POLL_SECONDS if num_workers + 1 <= usable else 0.0
         self._spin_seconds = float(poll_seconds)

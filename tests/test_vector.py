@@ -164,6 +164,8 @@ def test_close_ends_the_workers_and_frees_shared_memory():
 def test_bad_arguments_fail_in_the_calling_process():
     with pytest.raises(ValueError, match=r"\(5, 7, 9, 11, 13\)"):
         MazeVectorEnv(2, "labyrinth", size=4)
+    with pytest.raises(ValueError, match="poll_seconds"):
+        MazeVectorEnv(2, "labyrinth", poll_seconds=-1)
     with pytest.raises(ValueError, match="autoreset_mode"):
         MazeVectorEnv(2, "labyrinth", autoreset_mode="disabled")
     with pytest.raises(ValueError, match="unknown scenario"):
@@ -184,8 +186,9 @@ def test_where_an_env_is_stepped_changes_nothing():
 
     in_workers = run(num_workers=2, step_in_caller=False)
     shared = run(num_workers=1, step_in_caller=True)  # envs 0-1 in the worker, 2-3 in this process
+    sleeping = run(num_workers=1, poll_seconds=0)  # waits block at once instead of polling first
     in_caller = run(num_workers=0)
-    for other in (shared, in_caller):
+    for other in (shared, sleeping, in_caller):
         assert np.array_equal(in_workers[0], other[0]) and np.array_equal(in_workers[1], other[1])
 
 
