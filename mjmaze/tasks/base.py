@@ -98,23 +98,32 @@ class MazePhysics(mujoco.Physics):
         self.data.qvel[:3] = 0.0
 
     def object_ids(self, names: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
-        """``(mocap ids, geom ids)`` of scenario objects (see :class:`mjmaze.mjcf.ObjectGeom`).
+        """``(ids for place_objects, geom ids)`` of scenario objects (see :class:`mjmaze.mjcf.ObjectGeom`).
 
+        Both are the objects' geom ids (the pair keeps scenario code unchanged).
         Looked up once per list of names (Two-colour asks for 91 at every reset).
         """
         key = tuple(names)
         cache = self.__dict__.setdefault("_object_ids", {})
         if key not in cache:
             model = self.model.ptr
-            bodies = [mj.mj_name2id(model, mj.mjtObj.mjOBJ_BODY, name) for name in names]
-            geoms = [mj.mj_name2id(model, mj.mjtObj.mjOBJ_GEOM, name) for name in names]
-            cache[key] = model.body_mocapid[bodies].copy(), np.array(geoms, dtype=int)
-        mocap_ids, geom_ids = cache[key]
-        return mocap_ids.copy(), geom_ids.copy()
+            cache[key] = np.array([mj.mj_name2id(model, mj.mjtObj.mjOBJ_GEOM, name) for name in names], dtype=int)
+        geom_ids = cache[key]
+        return geom_ids.copy(), geom_ids.copy()
 
-    def place_objects(self, mocap_ids, xy) -> None:
-        """Moves objects to floor positions ``xy`` (shape ``(n, 2)`` or ``(2,)``)."""
-        self.data.ptr.mocap_pos[mocap_ids, :2] = xy
+    def place_objects(self, object_ids, xy) -> None:
+        """Moves objects (ids from :meth:`object_ids`) to floor positions ``xy`` (shape ``(n, 2)`` or ``(2,)``).
+
+        An object in a mocap body (one that collides) moves by ``data.mocap_pos``,
+        any other by its geom's position in the model.
+        """
+        model = self.model.ptr
+        ids = np.atleast_1d(object_ids)
+        xy = np.broadcast_to(np.asarray(xy, dtype=float).reshape(-1, 2), (len(ids), 2))
+        mocap = model.body_mocapid[model.geom_bodyid[ids]]
+        in_body = mocap >= 0
+        self.data.ptr.mocap_pos[mocap[in_body], :2] = xy[in_body]
+        model.geom_pos[ids[~in_body], :2] = xy[~in_body]
 
     def show_objects(self, geom_ids, visible) -> None:
         """Shows (True) or hides (False) objects in the agent's view."""
