@@ -51,7 +51,7 @@ from gymnasium.vector.utils import batch_space
 from mjmaze import registry, suite
 
 SHARED_MEMORY_PREFIX = "mjmaze_"
-# How long a waiting process polls before it sleeps by default (see _spin_then_block).
+# How long a waiting process polls before it sleeps by default (see _poll_then_block).
 POLL_SECONDS = 0.002
 AUTORESET_MODES = {"next_step": AutoresetMode.NEXT_STEP, "same_step": AutoresetMode.SAME_STEP}
 
@@ -165,8 +165,8 @@ class _EnvGroup:
         self._envs = []
 
 
-def _spin_then_block(conn, spin_seconds: float) -> None:
-    """Returns once ``conn`` can be read: polls for up to ``spin_seconds``, then sleeps.
+def _poll_then_block(conn, poll_seconds: float) -> None:
+    """Returns once ``conn`` can be read: polls for up to ``poll_seconds``, then sleeps.
 
     A process that sleeps between steps wakes up late (~0.2 ms on a virtual
     machine) and slow (caches gone cold): measured, a worker that blocked on its
@@ -175,14 +175,14 @@ def _spin_then_block(conn, spin_seconds: float) -> None:
     core, so the vector env polls only then.
     """
     clock = time.perf_counter
-    spin_until = clock() + spin_seconds
-    while clock() < spin_until:
+    poll_until = clock() + poll_seconds
+    while clock() < poll_until:
         if conn.poll(0):
             return
     conn.poll(None)
 
 
-def _worker(worker_id, conn, shm_name, layout, env_ids, first_configs, scenario, task_kwargs, same_step, spin_seconds):
+def _worker(worker_id, conn, shm_name, layout, env_ids, first_configs, scenario, task_kwargs, same_step, poll_seconds):
     """A worker's loop: build its envs, then answer step / reset / close commands.
 
     ``scenario`` is the declaration (:class:`mjmaze.registry.Scenario`), not a
@@ -200,7 +200,7 @@ def _worker(worker_id, conn, shm_name, layout, env_ids, first_configs, scenario,
         conn.send(None)
         clock = time.perf_counter
         while True:
-            _spin_then_block(conn, spin_seconds)
+            _poll_then_block(conn, poll_seconds)
             command, argument = conn.recv()
             started = clock()
             if command == "step":
@@ -262,9 +262,10 @@ class MazeVectorEnv(gym.vector.VectorEnv):
         answer (default). False: every env is in a worker.
       poll_seconds: how long a waiting process (a worker waiting for the next
         step, the caller waiting for the workers) polls before it sleeps; waking
-        from sleep costs time (see ``_spin_then_block``), polling costs a core.
+        from sleep costs time (see ``_poll_then_block``), polling holds a core.
         Default: 2 ms when every process has a core of its own, else 0. Pass 0
-        when the caller computes between steps (a network acting on the frames).
+        when the caller needs every core between steps (a network on several
+        threads; ``mjmaze.train.a2c`` acts on one thread, and polls).
       autoreset_mode: ``"next_step"`` (default) or ``"same_step"`` (see the module docstring).
       copy: return a copy of the shared observations (default). ``False`` returns the
         shared array itself, which the next step overwrites: faster, for a loop
@@ -332,7 +333,7 @@ class MazeVectorEnv(gym.vector.VectorEnv):
             raise ValueError(f"poll_seconds must be >= 0 (or None for the default), got {poll_seconds!r}")
         if poll_seconds is None:  # poll only when every process (the workers and this one) has a core
             poll_seconds = POLL_SECONDS if num_workers + 1 <= usable else 0.0
-        self._spin_seconds = float(poll_seconds)
+        self._poll_seconds = float(poll_seconds)
         self._steps_taken = 0
         self._step_seconds = self._wait_seconds = self._local_seconds = 0.0
         self._error: WorkerError | None = None
@@ -365,7 +366,7 @@ class MazeVectorEnv(gym.vector.VectorEnv):
                     target=_worker,
                     name=f"mjmaze-worker-{worker_id}",
                     args=(worker_id, child_end, self._shm.name, layout, env_ids, [offsets[i] for i in env_ids],
-                          declaration, task_kwargs, same_step, self._spin_seconds),
+                          declaration, task_kwargs, same_step, self._poll_seconds),
                     daemon=True,
                 )
                 process.start()
@@ -514,8 +515,8 @@ class MazeVectorEnv(gym.vector.VectorEnv):
     def _collect(self) -> None:
         """Waits for every worker's answer; a dead, failing or silent worker raises."""
         pending = dict(enumerate(self._conns))
-        spin_until = time.perf_counter() + self._spin_seconds
-        while pending and time.perf_counter() < spin_until:  # see _spin_then_block
+        poll_until = time.perf_counter() + self._poll_seconds
+        while pending and time.perf_counter() < poll_until:  # see _poll_then_block
             for worker_id, conn in list(pending.items()):
                 if conn.poll(0):
                     self._receive(worker_id, conn)
