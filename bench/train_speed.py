@@ -81,8 +81,29 @@ def network_only(device: torch.device, repeats: int = 3) -> float:
     return statistics.median(rates[1:])  # the first pass warms up
 
 
-def training(updates: int, device: str, checkout: pathlib.Path | None = None, scenario: str = "labyrinth") -> float:
-    """Median obs/s of a short training run, from this checkout or from ``checkout``."""
+def _rss_mb(pid: int) -> float:
+    try:
+        with open(f"/proc/{pid}/status") as f:
+            return next(int(line.split()[1]) / 1024 for line in f if line.startswith("VmRSS:"))
+    except (OSError, StopIteration):
+        return 0.0
+
+
+def _children(pid: int) -> list[int]:
+    try:
+        with open(f"/proc/{pid}/task/{pid}/children") as f:
+            return [int(child) for child in f.read().split()]
+    except OSError:
+        return []
+
+
+def training(updates: int, device: str, checkout: pathlib.Path | None = None,
+             scenario: str = "labyrinth") -> tuple[float, float]:
+    """``(median obs/s, largest env worker RSS in MB)`` of a short training run, from this checkout or ``checkout``.
+
+    The RSS is sampled every 0.2 s from the training process's children (its env
+    workers; multiprocessing's resource tracker is small and never the largest).
+    """
     difficulty = ["--size", "5"] if scenario == "labyrinth" else []
     with tempfile.TemporaryDirectory() as runs:
         command = [
@@ -90,9 +111,15 @@ def training(updates: int, device: str, checkout: pathlib.Path | None = None, sc
             "--total-steps", str(updates * NUM_ENVS * NUM_STEPS), "--runs-dir", runs, "--run-name", "bench",
             "--no-progress", "--device", device, "--checkpoint-every", str(10**12),
         ]
-        subprocess.run(command, check=True, cwd=runs, env=baseline.environment(checkout), stdout=subprocess.DEVNULL)
+        process = subprocess.Popen(command, cwd=runs, env=baseline.environment(checkout), stdout=subprocess.DEVNULL)
+        worker_rss = 0.0
+        while process.poll() is None:
+            worker_rss = max([worker_rss] + [_rss_mb(child) for child in _children(process.pid)])
+            time.sleep(0.2)
+        if process.returncode:
+            raise subprocess.CalledProcessError(process.returncode, command)
         lines = (pathlib.Path(runs) / "bench" / "metrics.jsonl").read_text().splitlines()
-    return statistics.median(json.loads(line)["sps"] for line in lines[2:])
+    return statistics.median(json.loads(line)["sps"] for line in lines[2:]), worker_rss
 
 
 def main() -> None:
@@ -110,12 +137,15 @@ def main() -> None:
     with baseline.checkout(args.baseline) if args.baseline else contextlib.nullcontext() as old:
         sides = {"this checkout": None} | ({f"baseline {args.baseline}": old} if args.baseline else {})
         rates: dict[str, list[float]] = {name: [] for name in sides}
+        worker_rss: dict[str, float] = dict.fromkeys(sides, 0.0)
         for round_ in range(args.rounds):
             for name, checkout in (sides.items() if round_ % 2 == 0 else reversed(sides.items())):
-                rates[name].append(training(args.updates, args.device, checkout, args.scenario))
+                rate, rss = training(args.updates, args.device, checkout, args.scenario)
+                rates[name].append(rate)
+                worker_rss[name] = max(worker_rss[name], rss)
     for name, values in rates.items():
         print(f"  training {args.scenario}, {name:<24} {statistics.median(values):8.0f} obs/s   "
-              f"({', '.join(f'{v:.0f}' for v in values)})")
+              f"({', '.join(f'{v:.0f}' for v in values)}); an env worker's RSS up to {worker_rss[name]:.0f} MB")
     if args.baseline:
         new, old = (statistics.median(v) for v in rates.values())
         print(f"  ratio this / baseline: {new / old:.2f}")
