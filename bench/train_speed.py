@@ -51,7 +51,7 @@ def env_only(seconds: float = 6.0) -> float:
 
 
 def network_only(device: torch.device, repeats: int = 3) -> float:
-    rollout_threads, update_threads = a2c._cpu_threads(run_settings.Args(), device)
+    rollout_threads, update_threads = a2c.cpu_threads(run_settings.Args(), device)
     agent = Agent(5).to(device)
     optimizer = torch.optim.RMSprop(agent.parameters(), lr=7e-4, alpha=0.99)
     frames = torch.randint(0, 256, (NUM_STEPS, NUM_ENVS, 64, 112, 3), dtype=torch.uint8)

@@ -142,7 +142,7 @@ def _loop(args, make_envs, envs, agent, optimizer, device, run_dir, step, update
     # a job started in the background may inherit an ignored SIGINT).
     previous_handlers = {sig: signal.signal(sig, _raise_stop) for sig in (signal.SIGINT, signal.SIGTERM)}
     stopped, failures, rebuilds = False, 0, 0
-    rollout_threads, update_threads = _cpu_threads(args, device)
+    rollout_threads, update_threads = cpu_threads(args, device)
     try:
         while step < args.total_steps:
             start_time = time.perf_counter()
@@ -253,7 +253,7 @@ def _loop(args, make_envs, envs, agent, optimizer, device, run_dir, step, update
     return run_dir
 
 
-def _cpu_threads(args: Args, device: torch.device) -> tuple[int, int]:
+def cpu_threads(args: Args, device: torch.device) -> tuple[int, int]:
     """Torch threads for the rollout and for the update.
 
     On CPU the rollout's forward passes (one small batch per step) run on one

@@ -118,12 +118,7 @@ class MazePhysics(mujoco.Physics):
         any other by its geom's position in the model.
         """
         model = self.model.ptr
-        if np.ndim(object_ids) == 0:  # one object (Two-colour spawns one every few steps): no array work
-            mocap = model.body_mocapid[model.geom_bodyid[object_ids]]
-            target = self.data.ptr.mocap_pos[mocap] if mocap >= 0 else model.geom_pos[object_ids]
-            target[:2] = xy
-            return
-        ids = np.asarray(object_ids)
+        ids = np.atleast_1d(object_ids)
         xy = np.broadcast_to(np.asarray(xy, dtype=float).reshape(-1, 2), (len(ids), 2))
         mocap = model.body_mocapid[model.geom_bodyid[ids]]
         in_body = mocap >= 0
