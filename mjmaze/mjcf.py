@@ -119,18 +119,8 @@ def build_xml(
 
     # A placeholder mesh with room for the most quads any maze needs (every
     # segment cut into pieces, all five quads each); WallLayout.apply overwrites
-    # it before first use. Its vertices are all distinct (disjoint boxes, the
-    # corners each quad shares nudged apart), so the compiler merges none.
-    capacity = len(segments) * _pieces_per_segment(cell_size)
-    offsets = np.stack([np.arange(capacity) * 2.0, np.zeros(capacity)], axis=1)
-    verts, faces, _, _, texcoords = _box_mesh(np.hstack([offsets, np.full((capacity, 2), 0.5)]))
-    verts += np.tile(np.arange(4)[:, None] * [1e-3, 1e-3, 0.0], (capacity * _BOX_QUADS, 1))
-    ET.SubElement(
-        asset, "mesh", name=WALL_MESH, inertia="shell",
-        vertex=" ".join(f"{v:.4f}" for v in verts.ravel()),
-        face=" ".join(str(f) for f in faces.ravel()),
-        texcoord=" ".join(f"{v:.4f}" for v in texcoords.ravel()),
-    )
+    # it before first use.
+    add_placeholder_mesh(asset, WALL_MESH, len(segments) * _pieces_per_segment(cell_size) * _BOX_QUADS)
     ET.SubElement(worldbody, "geom", name="walls_visual", type="mesh", mesh=WALL_MESH, material="wall")
     # The floor after the walls: MuJoCo draws geoms in model order, so floor
     # pixels hidden by walls fail the depth test before any shading.
@@ -161,6 +151,59 @@ def build_xml(
         else:
             ET.SubElement(worldbody, "geom", **{"class": "item"}, pos=f"0 0 {obj.z}", **attrs)
     return ET.tostring(root, encoding="unicode")
+
+
+def add_placeholder_mesh(asset: ET.Element, name: str, quads: int) -> None:
+    """Adds mesh ``name`` with room for ``quads`` wall quads, to be overwritten by :func:`write_wall_mesh`.
+
+    Its vertices are all distinct (disjoint boxes, the corners each quad shares
+    nudged apart), so the compiler merges none and the compiled mesh keeps
+    ``4 * quads`` vertices.
+    """
+    boxes = -(-quads // _BOX_QUADS)
+    offsets = np.stack([np.arange(boxes) * 2.0, np.zeros(boxes)], axis=1)
+    keep = (np.arange(boxes * _BOX_QUADS) < quads).reshape(boxes, _BOX_QUADS)
+    verts, faces, _, _, texcoords = _box_mesh(np.hstack([offsets, np.full((boxes, 2), 0.5)]), keep)
+    verts += np.tile(np.arange(4)[:, None] * [1e-3, 1e-3, 0.0], (quads, 1))
+    ET.SubElement(
+        asset, "mesh", name=name, inertia="shell",
+        vertex=" ".join(f"{v:.4f}" for v in verts.ravel()),
+        face=" ".join(str(f) for f in faces.ravel()),
+        texcoord=" ".join(f"{v:.4f}" for v in texcoords.ravel()),
+    )
+
+
+def write_wall_mesh(model: mujoco.MjModel, mesh_id: int, h_walls: np.ndarray, v_walls: np.ndarray, cell_size: float) -> None:
+    """Overwrites mesh ``mesh_id`` (see :func:`add_placeholder_mesh`) with the visual walls of a layout.
+
+    Vertices are in world coordinates: the geom drawing the mesh must sit at
+    the origin, unrotated (the compiler recentres a mesh; undo it).
+    """
+    h_walls, v_walls = np.asarray(h_walls, dtype=bool), np.asarray(v_walls, dtype=bool)
+    verts, faces, normals, face_normals, texcoords = _wall_mesh(
+        h_walls.tobytes(), h_walls.shape, v_walls.tobytes(), v_walls.shape, cell_size
+    )
+    vert_adr, face_adr = model.mesh_vertadr[mesh_id], model.mesh_faceadr[mesh_id]
+    normal_adr, texcoord_adr = model.mesh_normaladr[mesh_id], model.mesh_texcoordadr[mesh_id]
+    # The compiled placeholder's vertex and texcoord counts never change (4 per
+    # quad, as many faces as half its vertices, a normal per quad at most).
+    if model.mesh_vertnum[mesh_id] < len(verts) or model.mesh_texcoordnum[mesh_id] < len(texcoords):
+        raise RuntimeError("the compiled wall mesh is smaller than its placeholder: vertices were merged")
+    model.mesh_vert[vert_adr : vert_adr + len(verts)] = verts
+    model.mesh_face[face_adr : face_adr + len(faces)] = faces
+    model.mesh_facenormal[face_adr : face_adr + len(faces)] = face_normals
+    model.mesh_normal[normal_adr : normal_adr + len(normals)] = normals
+    model.mesh_texcoord[texcoord_adr : texcoord_adr + len(texcoords)] = texcoords
+    model.mesh_facetexcoord[face_adr : face_adr + len(faces)] = faces
+    # mjr_uploadMesh sends mesh_facenum faces: only as many as this layout needs.
+    model.mesh_facenum[mesh_id] = len(faces)
+
+
+def wall_mesh_quads(h_walls: np.ndarray, v_walls: np.ndarray, cell_size: float) -> int:
+    """How many quads the visual walls of a layout have (the room its mesh needs)."""
+    h_walls, v_walls = np.asarray(h_walls, dtype=bool), np.asarray(v_walls, dtype=bool)
+    normals = _wall_mesh(h_walls.tobytes(), h_walls.shape, v_walls.tobytes(), v_walls.shape, cell_size)[2]
+    return len(normals)
 
 
 def _add_textures(root: ET.Element) -> None:
@@ -313,18 +356,7 @@ class WallLayout:
         model.geom_pos[visual] = 0.0
         model.geom_quat[visual] = (1.0, 0.0, 0.0, 0.0)
         model.geom_rbound[visual] = 0.0  # 0 = never culled by bounding sphere
-        vert_adr, face_adr, normal_adr = (
-            model.mesh_vertadr[self.mesh_id], model.mesh_faceadr[self.mesh_id], model.mesh_normaladr[self.mesh_id]
-        )
-        n = len(self._segments)
-        self._verts = model.mesh_vert[vert_adr : vert_adr + n * _BOX_VERTS]
-        self._faces = model.mesh_face[face_adr : face_adr + n * _BOX_FACES]
-        self._face_normals = model.mesh_facenormal[face_adr : face_adr + n * _BOX_FACES]
-        self._normals = model.mesh_normal[normal_adr : normal_adr + n * _BOX_NORMALS]
-        texcoord_adr = model.mesh_texcoordadr[self.mesh_id]
-        self._texcoords = model.mesh_texcoord[texcoord_adr : texcoord_adr + n * _BOX_VERTS]
-        self._face_texcoords = model.mesh_facetexcoord[face_adr : face_adr + n * _BOX_FACES]
-        if len(self._verts) < n * _BOX_VERTS or len(self._texcoords) < n * _BOX_VERTS:
+        if model.mesh_vertnum[self.mesh_id] < len(self._segments) * _pieces_per_segment(cell_size) * _BOX_VERTS:
             raise RuntimeError("the compiled wall mesh is smaller than its placeholder: vertices were merged")
 
     def apply(self, h_walls: np.ndarray, v_walls: np.ndarray) -> None:
@@ -337,19 +369,8 @@ class WallLayout:
         model.geom_contype[ids] = present
         model.geom_conaffinity[ids] = present
         # Visual mesh: one box per straight run of walls, and only as many faces
-        # as they need (mjr_uploadMesh sends mesh_facenum faces): fewer vertices
-        # for the rasteriser, whatever the grid's capacity.
-        h_walls, v_walls = np.asarray(h_walls, dtype=bool), np.asarray(v_walls, dtype=bool)
-        verts, faces, normals, face_normals, texcoords = _wall_mesh(
-            h_walls.tobytes(), h_walls.shape, v_walls.tobytes(), v_walls.shape, self._cell_size
-        )
-        self._verts[: len(verts)] = verts
-        self._faces[: len(faces)] = faces
-        self._face_normals[: len(face_normals)] = face_normals
-        self._normals[: len(normals)] = normals
-        self._texcoords[: len(texcoords)] = texcoords
-        self._face_texcoords[: len(faces)] = faces
-        model.mesh_facenum[self.mesh_id] = len(faces)
+        # as they need: fewer vertices for the rasteriser, whatever the grid's capacity.
+        write_wall_mesh(model, self.mesh_id, h_walls, v_walls, self._cell_size)
 
 
 def wall_runs(h_walls: np.ndarray, v_walls: np.ndarray, cell_size: float) -> np.ndarray:

@@ -14,7 +14,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import mjmaze
-from mjmaze import configs, maze, mjcf, registry, suite
+from mjmaze import configs, maze, mjcf, registry, rules, suite
 from mjmaze.tasks import base
 
 # -- a fifth scenario, stated once, here ---------------------------------------------
@@ -32,21 +32,22 @@ class Beacon(base.MazeTask):
         base._check_choice("size", size, (3, 4))
         layout = configs.LayoutSpec(size, 1.0, maze.DEFAULT_KEEP_PROBABILITY, num_objects=1)
         super().__init__(difficulty=size, layout=layout, **kwargs)
-        self._goal_xy, self._reached = (0.0, 0.0), False
 
-    def start_episode(self, physics, config):
-        self._goal_xy = config.cell_centre(config.object_cells[0])
-        mocap_ids, geom_ids = physics.object_ids([GOAL.name])
-        physics.place_objects(mocap_ids, self._goal_xy)
-        physics.show_objects(geom_ids, True)
-        self._reached = False
+    def start(self, xp, config, keys):
+        batch = keys.shape[0]
+        return {
+            "pose": xp.concat([config["spawn_xy"], self.spawn_yaw(xp, keys)[:, None]], axis=1),
+            "object_xy": config["object_xy"],
+            "object_shown": xp.ones((batch, 1), dtype=xp.bool),
+            "reached": xp.zeros(batch, dtype=xp.bool),
+        }
 
-    def scenario_step(self, physics, path):
-        self._reached = base.touches(self._goal_xy, path)
-        return float(self._reached), self._reached
+    def rules(self, xp, state, path):
+        state["reached"] = rules.touched(xp, state["object_xy"][:, 0], path)
+        return xp.astype(state["reached"], xp.float64), state["reached"]
 
-    def metrics(self):
-        return {"reached": self._reached}
+    def episode_metrics(self, state):
+        return {"reached": state["reached"]}
 
 
 SCENARIO = registry.Scenario(

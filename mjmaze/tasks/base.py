@@ -2,9 +2,13 @@
 
 A scenario subclasses :class:`MazeTask` and states only its rules: which
 objects the arena has (:attr:`MazeTask.objects`), how an episode starts
-(:meth:`MazeTask.start_episode`) and what one agent step pays and whether it
-ends the episode (:meth:`MazeTask.scenario_step`). Stepping, rendering and the
-time limit live here, once.
+(:meth:`MazeTask.start`) and what one agent step pays and whether it ends the
+episode (:meth:`MazeTask.rules`). Both rules are array functions over a batch
+of envs (:mod:`mjmaze.rules`): this task calls them with a batch of one on
+numpy, the MuJoCo Warp backend (:mod:`mjmaze.warp`) with thousands on torch.
+The rules only say where objects are and whether they are shown
+(``state["object_xy"]``, ``state["object_shown"]``); each backend moves its
+arena to match. Stepping, rendering and the time limit live here, once.
 """
 
 from __future__ import annotations
@@ -22,7 +26,7 @@ from dm_control.rl import control
 from dm_control.suite import base
 from dm_env import specs
 
-from mjmaze import configs, mjcf, render
+from mjmaze import configs, mjcf, render, rules
 from mjmaze import layouts as layout_files
 
 # Timing: one physics step is one Doom tic; the agent acts every 4 tics.
@@ -31,8 +35,7 @@ EPISODE_STEPS = 525  # 2100 tics
 # Motion per agent step in open space.
 FORWARD_PER_STEP = 0.25  # metres
 TURN_PER_STEP = math.radians(15.0)
-# An item is picked up when the agent's centre is this close (floor plane).
-PICKUP_RADIUS = 0.3
+PICKUP_RADIUS = rules.PICKUP_RADIUS
 AGENT_RADIUS = 0.125
 
 DEFAULT_WIDTH, DEFAULT_HEIGHT = 112, 64
@@ -175,11 +178,14 @@ class MazeTask(base.Task):
             self.configs = configs.ConfigSet(self.scenario, difficulty, split, layout, num_configs)
         else:
             self.configs = _imported_configs(layouts, self.scenario, layout, num_configs)
-        self._config_sampling = config_sampling
-        self._first_config = int(first_config)
-        self._actions = ACTION_SETS[action_set]
-        self._width, self._height = int(width), int(height)
+        self.config_sampling = config_sampling
+        self.first_config = int(first_config)
+        self.action_set = action_set
+        #: ``(forward, turn)`` of each action.
+        self.actions = ACTION_SETS[action_set]
+        self.width, self.height = int(width), int(height)
         self._episode = 0
+        self._seed_key = rules.seed_key(self.random)
         #: Where observations go: None = a fresh array per observation; an array
         #: (e.g. a slot of a vector env's shared memory) = rendered into it.
         self.observation_buffer: np.ndarray | None = None
@@ -190,7 +196,8 @@ class MazeTask(base.Task):
         self._bound_data = None
         self.config: configs.MazeConfig | None = None
         self._config_in_model: configs.MazeConfig | None = None
-        self._steps = 0
+        #: The episode's state as the rules see it: arrays with a batch of one (see :meth:`start`).
+        self.state: dict[str, np.ndarray] | None = None
         self._reward = 0.0
         self._return = 0.0
         self._ended = False
@@ -200,6 +207,7 @@ class MazeTask(base.Task):
     def reseed(self, seed: int | None) -> None:
         """Restarts the episode sequence: same seed, same episodes."""
         self.random.seed(seed)
+        self._seed_key = rules.seed_key(self.random)
         self._episode = 0
 
     def _bind(self, physics: MazePhysics) -> None:
@@ -212,74 +220,139 @@ class MazeTask(base.Task):
         self._model, self._bound_data = model, data
         self._qpos, self._qvel = data.qpos, data.qvel
         self._walls = mjcf.WallLayout(model, self.layout.grid_size, self.layout.cell_size)
-        self._renderer = render.EgoRenderer(model, CAMERA, self._width, self._height)
+        self._renderer = render.EgoRenderer(model, CAMERA, self.width, self.height)
         fovy = math.radians(model.cam(CAMERA).fovy[0])
-        self.horizontal_fov = 2 * math.atan(math.tan(fovy / 2) * self._width / self._height)
+        self.horizontal_fov = 2 * math.atan(math.tan(fovy / 2) * self.width / self.height)
         self._config_in_model = None
-        self._speed = FORWARD_PER_STEP / (TICS_PER_STEP * model.opt.timestep)
-        self._turn_rate = TURN_PER_STEP / (TICS_PER_STEP * model.opt.timestep)
+        self._object_ids = physics.object_ids([geom.name for geom in self.objects])[1]
 
-    def next_config_index(self) -> int:
-        if self._config_sampling == "random":
-            return int(self.random.randint(len(self.configs)))
-        return (self._first_config + self._episode) % len(self.configs)
+    def episode_keys(self, xp, seed_keys, episodes):
+        """Each env's key for the draws of its episode number ``episodes`` (both ``(B,)`` int64)."""
+        return rules.mix(xp, seed_keys, episodes)
+
+    def config_indices(self, xp, keys, episodes, first=None):
+        """The configuration each env plays in its episode number ``episodes``: ``(B,)`` int64.
+
+        ``first``: where each env starts cycling (default: ``first_config``).
+        """
+        if self.config_sampling == "random":
+            return xp.astype(rules.uniform(xp, keys, rules.DRAW_CONFIG) * len(self.configs), xp.int64)
+        return ((self.first_config if first is None else first) + episodes) % len(self.configs)
 
     def initialize_episode(self, physics: MazePhysics) -> None:
         self._bind(physics)
-        config = self.configs[self.next_config_index()]
+        episode = np.array([self._episode], dtype=np.int64)
+        key = self.episode_keys(np, np.array([self._seed_key], dtype=np.int64), episode)
+        config = self.configs[int(self.config_indices(np, key, episode)[0])]
         self._episode += 1
         if config is not self._config_in_model:
             self._walls.apply(config.h_walls, config.v_walls)
             self._renderer.upload_mesh(self._walls.mesh_id)
             self._config_in_model = config
         self.config = config
-        self._steps, self._reward, self._return, self._ended = 0, 0.0, 0.0, False
-        x, y, yaw = self.spawn_pose(config)
-        physics.set_agent_pose(x, y, yaw)
-        self.start_episode(physics, config)
+        self._reward, self._return, self._ended = 0.0, 0.0, False
+        self.state = self.start_state(np, self.config_arrays([config]), key)
+        physics.set_agent_pose(*self.state["pose"][0].tolist())
+        self._sync_objects(physics, everything=True)
 
-    def spawn_pose(self, config: configs.MazeConfig) -> tuple[float, float, float]:
-        """Spawn at the spawn cell's centre with a uniformly drawn heading."""
-        x, y = config.cell_centre(config.spawn_cell)
-        return x, y, self.random.uniform(-math.pi, math.pi)
+    def _sync_objects(self, physics: MazePhysics, everything: bool = False) -> None:
+        """Moves, shows, hides, colours the arena's objects as :attr:`state` says (what changed)."""
+        state, ids = self.state, self._object_ids
+        xy, shown = state["object_xy"][0], state["object_shown"][0]
+        if everything:
+            self._xy_in_model = np.full_like(xy, np.nan)
+            self._shown_in_model = ~shown
+            self._collides_in_model = np.ones(len(ids), dtype=bool)
+            if "object_rgba" in state:
+                for geom, rgba in zip(ids, state["object_rgba"][0]):
+                    physics.set_object_rgba(geom, rgba)
+        moved = np.flatnonzero((xy != self._xy_in_model).any(axis=1))
+        if len(moved):
+            physics.place_objects(ids[moved], xy[moved])
+            self._xy_in_model = xy.copy()
+        flipped = np.flatnonzero(shown != self._shown_in_model)
+        if len(flipped):
+            physics.show_objects(ids[flipped], shown[flipped])
+            self._shown_in_model = shown.copy()
+        if "object_collides" in state:
+            collides = state["object_collides"][0]
+            for k in np.flatnonzero(collides != self._collides_in_model):
+                physics.set_object_collisions(ids[k], bool(collides[k]))
+            self._collides_in_model = collides.copy()
 
-    # -- scenario hooks --------------------------------------------------
+    # -- the scenario's rules, over a batch of envs (see mjmaze.rules) ---------
+
+    def config_arrays(self, configs_: Sequence[configs.MazeConfig]) -> dict[str, np.ndarray]:
+        """What the rules need of each configuration, stacked: ``(C, ...)`` numpy arrays.
+
+        ``spawn_xy`` ``(C, 2)``, the spawn cell's centre; ``object_xy``
+        ``(C, num_objects, 2)``, the object cells' centres. A scenario that
+        needs more (Two-colour: the walls) extends this.
+        """
+        return {
+            "spawn_xy": np.array([config.cell_centre(config.spawn_cell) for config in configs_], dtype=np.float64),
+            "object_xy": np.array(
+                [[config.cell_centre(cell) for cell in config.object_cells] for config in configs_], dtype=np.float64
+            ).reshape(len(configs_), self.layout.num_objects, 2),
+        }
+
+    def spawn_yaw(self, xp, keys):
+        """A heading drawn uniformly in ``[-pi, pi)`` per env."""
+        return rules.uniform(xp, keys, rules.DRAW_YAW) * (2 * math.pi) - math.pi
 
     @abc.abstractmethod
-    def start_episode(self, physics: MazePhysics, config: configs.MazeConfig) -> None:
-        """Places the scenario's objects and resets its state."""
+    def start(self, xp, config: dict, keys) -> dict:
+        """The state of new episodes: ``config`` holds :meth:`config_arrays` rows, ``keys`` ``(B,)`` the draws' keys.
 
-    @abc.abstractmethod
-    def scenario_step(self, physics: MazePhysics, path: np.ndarray) -> tuple[float, bool]:
-        """Applies the rules after one agent step: ``(reward, episode ends)``.
-
-        ``path`` ``(tics, 2)`` holds the agent's ``(x, y)`` after each tic of the
-        step, so a pick-up passed in the middle of a step counts (Doom tests
-        every tic); see :func:`touches` and :func:`reached`.
+        Returns a dict of ``(B, ...)`` arrays with at least ``pose`` ``(B, 3)``
+        (the spawn: x, y, yaw), ``object_xy`` ``(B, len(objects), 2)`` and
+        ``object_shown`` ``(B, len(objects))``; optionally ``object_rgba``
+        ``(B, len(objects), 4)`` (colours for this episode) and
+        ``object_collides`` ``(B, len(objects))``; plus the scenario's own
+        fields. Random draws come from :func:`mjmaze.rules.uniform` with ``keys``.
         """
 
     @abc.abstractmethod
-    def metrics(self) -> dict:
-        """The scenario's metric fields for ``info``."""
+    def rules(self, xp, state: dict, path) -> tuple:
+        """Applies the rules after one agent step, updating ``state``: ``(reward, episode ends)``, each ``(B,)``.
+
+        ``path`` ``(B, tics, 2)`` holds the agent's ``(x, y)`` after each tic of
+        the step, so a pick-up passed in the middle of a step counts (Doom tests
+        every tic); see :func:`mjmaze.rules.first_tic`. ``state["steps"]`` is the
+        number of agent steps taken, this one included.
+        """
+
+    @abc.abstractmethod
+    def episode_metrics(self, state: dict) -> dict:
+        """The scenario's metric fields, each a ``(B,)`` array."""
+
+    def start_state(self, xp, config: dict, keys) -> dict:
+        """:meth:`start` plus the step count and the keys: what both backends call at an episode's start."""
+        state = self.start(xp, config, keys)
+        state["key"] = keys
+        state["steps"] = xp.zeros(keys.shape, dtype=xp.int64, device=rules.device(keys))
+        return state
+
+    def step_state(self, xp, state: dict, path) -> tuple:
+        """One agent step of the rules for a batch: ``(reward, terminated, truncated)``, each ``(B,)``."""
+        state["steps"] = state["steps"] + 1
+        reward, terminated = self.rules(xp, state, path)
+        return reward, terminated, ~terminated & (state["steps"] >= EPISODE_STEPS)
 
     # -- the per-step path ------------------------------------------------
 
     def before_step(self, action, physics: MazePhysics) -> None:
-        forward, turn = self._actions[int(action)]
-        # Head along the middle of this step's turn, so a forward+turn step
-        # follows the chord of its arc.
-        heading = self._qpos[2] + 0.5 * turn * TURN_PER_STEP
-        speed = forward * self._speed
-        # No actuators: the velocity holds for the step's 4 tics unless a
-        # contact takes its normal part away (the agent slides along walls).
-        self._qvel[0] = speed * math.cos(heading)
-        self._qvel[1] = speed * math.sin(heading)
-        self._qvel[2] = turn * self._turn_rate
+        forward, turn = self.actions[int(action)]
+        # Plain floats and math (numpy's per-call cost is a fair part of a step here).
+        self._qvel[0], self._qvel[1], self._qvel[2] = agent_velocity(
+            math, forward, turn, float(self._qpos[2]), self._model.opt.timestep
+        )
 
     def after_step(self, physics: MazePhysics) -> None:
-        self._steps += 1
-        self._reward, self._ended = self.scenario_step(physics, physics.tic_xy)
+        reward, ended, _ = self.step_state(np, self.state, physics.tic_xy[None])
+        self._reward, self._ended = float(reward[0]), bool(ended[0])
         self._return += self._reward
+        self._sync_objects(physics)
 
     def advance(self, physics: MazePhysics, action) -> tuple[float, bool, bool]:
         """One agent step without a dm_control ``TimeStep``: ``(reward, terminated, truncated)``.
@@ -291,7 +364,7 @@ class MazeTask(base.Task):
         self.before_step(action, physics)
         physics.step(TICS_PER_STEP)
         self.after_step(physics)
-        return self._reward, self._ended, not self._ended and self._steps >= EPISODE_STEPS
+        return self._reward, self._ended, not self._ended and self.steps >= EPISODE_STEPS
 
     def get_observation(self, physics: MazePhysics) -> collections.OrderedDict:
         self._bind(physics)
@@ -309,28 +382,35 @@ class MazeTask(base.Task):
         # termination from truncation.
         if self._ended:
             return 0.0
-        if self._steps >= EPISODE_STEPS:
+        if self.steps >= EPISODE_STEPS:
             return 1.0
         return None
 
     # -- specs and analysis -------------------------------------------------
 
     def action_spec(self, physics: MazePhysics) -> specs.DiscreteArray:
-        return specs.DiscreteArray(len(self._actions), name="action")
+        return specs.DiscreteArray(len(self.actions), name="action")
 
     def observation_spec(self, physics: MazePhysics) -> collections.OrderedDict:
         return collections.OrderedDict(
-            pixels=specs.Array((self._height, self._width, 3), np.uint8, name="pixels")
+            pixels=specs.Array((self.height, self.width, 3), np.uint8, name="pixels")
         )
 
     @property
     def action_names(self) -> tuple[str, ...]:
-        return ACTION_NAMES[: len(self._actions)]
+        return ACTION_NAMES[: len(self.actions)]
 
     @property
     def steps(self) -> int:
         """Agent steps taken in the current episode."""
-        return self._steps
+        return int(self.state["steps"][0]) if self.state is not None else 0
+
+    def metrics(self) -> dict:
+        """The scenario's metric fields for ``info``, as Python scalars."""
+        state = self.state
+        if state is None:  # before the first episode: what a new episode reports
+            state = self.start_state(np, self.config_arrays([self.configs[0]]), np.zeros(1, dtype=np.int64))
+        return {name: value[0].item() for name, value in self.episode_metrics(state).items()}
 
     def info_fields(self) -> dict[str, type]:
         """Names and Python types of the fields of :meth:`get_info`, known before any episode."""
@@ -343,7 +423,7 @@ class MazeTask(base.Task):
         x, y, yaw = physics.agent_pose()
         info = self.metrics()
         info.update(
-            x=x, y=y, yaw=yaw, step=self._steps, episode_return=self._return,
+            x=x, y=y, yaw=yaw, step=self.steps, episode_return=self._return,
             config_index=self.config.index if self.config else -1,
         )
         return info
@@ -354,6 +434,21 @@ class MazeTask(base.Task):
             self._renderer.close()
             self._renderer = None
         self._bound_data = None
+
+
+def agent_velocity(xp, forward, turn, yaw, timestep: float):
+    """The agent's ``(vx, vy, yaw rate)`` for one step of ``forward`` (-1, 0, 1) and ``turn`` (-1, 0, 1, +1 left).
+
+    Works on floats (``xp = math``) and on arrays (``xp`` an array namespace), so
+    the CPU task and the Warp backend move the agent by the same statement. No
+    actuators: the velocity holds for the step's tics unless a contact takes
+    its normal part away (the agent slides along walls).
+    """
+    step_seconds = TICS_PER_STEP * timestep
+    # Head along the middle of this step's turn, so a forward+turn step follows the chord of its arc.
+    heading = yaw + 0.5 * turn * TURN_PER_STEP
+    speed = forward * (FORWARD_PER_STEP / step_seconds)
+    return speed * xp.cos(heading), speed * xp.sin(heading), turn * (TURN_PER_STEP / step_seconds)
 
 
 def make_environment(task: MazeTask, environment_kwargs: dict | None = None) -> control.Environment:
@@ -377,48 +472,6 @@ def _imported_configs(folder, scenario: str, layout: configs.LayoutSpec, num_con
                 f"with {layout.num_objects}"
             )
     return loaded[:num_configs] if num_configs else loaded
-
-
-def within_pickup(xy, x: float, y: float) -> bool:
-    """True if the agent at ``(x, y)`` is within pick-up range of the point ``xy``."""
-    dx, dy = x - xy[0], y - xy[1]
-    return dx * dx + dy * dy < PICKUP_RADIUS * PICKUP_RADIUS
-
-
-def _first_tic(px: float, py: float, tics: list) -> int:
-    """The first of ``tics`` (``[x, y]`` lists) within pick-up range of ``(px, py)``, -1 if none.
-
-    Plain floats: for 4 tics they beat numpy's per-call cost.
-    """
-    for tic, (x, y) in enumerate(tics):
-        if (x - px) ** 2 + (y - py) ** 2 < PICKUP_RADIUS * PICKUP_RADIUS:
-            return tic
-    return -1
-
-
-def touches(xy, path: np.ndarray) -> bool:
-    """True if ``path`` (the agent's positions after each tic of a step) comes within pick-up range of ``xy``."""
-    return _first_tic(xy[0], xy[1], path.tolist()) >= 0
-
-
-def reached(points: np.ndarray, path: np.ndarray) -> np.ndarray:
-    """The first tic at which ``path`` comes within pick-up range of each of ``points``, -1 if none.
-
-    ``points`` ``(n, 2)``; ``path`` ``(tics, 2)``, the agent's positions after
-    each tic of a step (:attr:`MazePhysics.tic_xy`). Array operations only:
-    Two-colour tests up to 90 items every step.
-    """
-    points = np.asarray(points, dtype=float).reshape(-1, 2)
-    # Most steps reach nothing: points outside the path's bounding box grown by
-    # the pick-up radius are out of reach, and one test over all points says so.
-    low, high = path.min(axis=0) - PICKUP_RADIUS, path.max(axis=0) + PICKUP_RADIUS
-    near = np.flatnonzero(((points > low) & (points < high)).all(axis=1))
-    first = np.full(len(points), -1)
-    if len(near):
-        offsets = points[near, None, :] - path[None, :, :]  # (near, tics, 2)
-        inside = np.einsum("ntk,ntk->nt", offsets, offsets) < PICKUP_RADIUS * PICKUP_RADIUS
-        first[near] = np.where(inside.any(axis=1), inside.argmax(axis=1), -1)
-    return first
 
 
 def _check_choice(name: str, value, valid: Sequence) -> None:

@@ -20,7 +20,7 @@ Metric
 
 from __future__ import annotations
 
-from mjmaze import configs, maze, mjcf, registry
+from mjmaze import configs, maze, mjcf, registry, rules
 from mjmaze.tasks import base
 
 SIZES = (5, 7, 9, 11, 13)
@@ -54,35 +54,32 @@ class FindReturn(base.MazeTask):
         # The spawn cell holds the green pillar; the one object is the red pillar.
         layout = configs.LayoutSpec(size, CELL_SIZE, maze.DEFAULT_KEEP_PROBABILITY, num_objects=1)
         super().__init__(difficulty=size, layout=layout, **kwargs)
-        self._green_xy = self._red_xy = (0.0, 0.0)
-        self._target_found = self._success = False
 
-    def spawn_pose(self, config: configs.MazeConfig) -> tuple[float, float, float]:
-        x, y, yaw = super().spawn_pose(config)
-        return x - SPAWN_OFFSET, y - SPAWN_OFFSET, yaw
+    def start(self, xp, config, keys):
+        batch, device = keys.shape[0], rules.device(keys)
+        green, red = config["spawn_xy"], config["object_xy"][:, 0]
+        return {
+            "pose": xp.concat([green - SPAWN_OFFSET, self.spawn_yaw(xp, keys)[:, None]], axis=1),
+            "object_xy": xp.stack([green, red], axis=1),
+            "object_shown": xp.ones((batch, 2), dtype=xp.bool, device=device),
+            "target_found": xp.zeros(batch, dtype=xp.bool, device=device),
+            "success": xp.zeros(batch, dtype=xp.bool, device=device),
+        }
 
-    def start_episode(self, physics: base.MazePhysics, config: configs.MazeConfig) -> None:
-        self._green_xy = config.cell_centre(config.spawn_cell)
-        self._red_xy = config.cell_centre(config.object_cells[0])
-        mocap_ids, geom_ids = physics.object_ids([GREEN_PILLAR.name, RED_PILLAR.name])
-        physics.place_objects(mocap_ids, [self._green_xy, self._red_xy])
-        physics.show_objects(geom_ids, True)
-        self._target_found = self._success = False
-
-    def scenario_step(self, physics: base.MazePhysics, path) -> tuple[float, bool]:
+    def rules(self, xp, state, path):
         # The pillars stand in different cells, more than a step apart: one
         # step never touches both, so target and return are checked in turn.
-        if not self._target_found:
-            if base.touches(self._red_xy, path):
-                self._target_found = True
-                return STEP_REWARD + TARGET_REWARD, False
-        elif base.touches(self._green_xy, path):
-            self._success = True
-            return STEP_REWARD + RETURN_REWARD, True
-        return STEP_REWARD, False
+        green, red = state["object_xy"][:, 0], state["object_xy"][:, 1]
+        found = state["target_found"]
+        target = ~found & rules.touched(xp, red, path)
+        returned = found & rules.touched(xp, green, path)
+        state["target_found"] = found | target
+        state["success"] = state["success"] | returned
+        reward = STEP_REWARD + TARGET_REWARD * xp.astype(target, xp.float64) + RETURN_REWARD * xp.astype(returned, xp.float64)
+        return reward, returned
 
-    def metrics(self) -> dict:
-        return {"success": self._success, "target_found": self._target_found}
+    def episode_metrics(self, state):
+        return {"success": state["success"], "target_found": state["target_found"]}
 
 
 SCENARIO = registry.Scenario(

@@ -24,8 +24,7 @@ differ in shape (:data:`KINDS`).
 
 from __future__ import annotations
 
-import numpy as np
-from mjmaze import configs, maze, mjcf, registry
+from mjmaze import configs, maze, mjcf, registry, rules
 from mjmaze.tasks import base
 
 NUM_ITEMS = tuple(range(1, 9))
@@ -70,31 +69,34 @@ class KItem(base.MazeTask):
         self.objects = tuple(geom for _, geom in KINDS[:num_items])
         layout = configs.LayoutSpec(size, CELL_SIZE, maze.DEFAULT_KEEP_PROBABILITY, num_objects=num_items)
         super().__init__(difficulty=num_items, layout=layout, **kwargs)
-        self._items_xy = np.zeros((num_items, 2))
-        self._next = 0
 
-    def start_episode(self, physics: base.MazePhysics, config: configs.MazeConfig) -> None:
-        # object_cells[k] holds item kind k.
-        self._items_xy = np.array([config.cell_centre(cell) for cell in config.object_cells])
-        self._mocap_ids, self._geom_ids = physics.object_ids([geom.name for geom in self.objects])
-        physics.place_objects(self._mocap_ids, self._items_xy)
-        physics.show_objects(self._geom_ids, True)
-        self._next = 0
+    def start(self, xp, config, keys):
+        batch, device = keys.shape[0], rules.device(keys)
+        return {
+            "pose": xp.concat([config["spawn_xy"], self.spawn_yaw(xp, keys)[:, None]], axis=1),
+            "object_xy": config["object_xy"],  # object_cells[k] holds item kind k
+            "object_shown": xp.ones((batch, self.num_items), dtype=xp.bool, device=device),
+            "next": xp.zeros(batch, dtype=xp.int64, device=device),
+        }
 
-    def scenario_step(self, physics: base.MazePhysics, path) -> tuple[float, bool]:
-        # Items left are kinds next..K-1, in cells 1.25 m apart: one step (0.25 m)
-        # reaches at most one of them, at any of its tics.
-        near = np.flatnonzero(base.reached(self._items_xy[self._next :], path) >= 0)
-        if not len(near):
-            return STEP_REWARD, False
-        if near[0] != 0:  # not the next in order
-            return STEP_REWARD + WRONG_ITEM_REWARD, True
-        physics.show_objects(self._geom_ids[self._next], False)
-        self._next += 1
-        return STEP_REWARD + NEXT_ITEM_REWARD, self._next == self.num_items
+    def rules(self, xp, state, path):
+        # Items are in cells 1.25 m apart: one step (0.25 m) reaches at most
+        # one of them, at any of its tics.
+        reached = (rules.first_tic(xp, state["object_xy"], path) >= 0) & state["object_shown"]
+        is_next = rules.one_hot(xp, state["next"], self.num_items)
+        correct = xp.any(reached & is_next, axis=1)
+        wrong = ~correct & xp.any(reached, axis=1)
+        state["object_shown"] = state["object_shown"] & ~(is_next & correct[:, None])
+        state["next"] = state["next"] + xp.astype(correct, xp.int64)
+        reward = (
+            STEP_REWARD
+            + NEXT_ITEM_REWARD * xp.astype(correct, xp.float64)
+            + WRONG_ITEM_REWARD * xp.astype(wrong, xp.float64)
+        )
+        return reward, wrong | (state["next"] == self.num_items)
 
-    def metrics(self) -> dict:
-        return {"items_in_order": self._next, "item_score": self._next / self.num_items}
+    def episode_metrics(self, state):
+        return {"items_in_order": state["next"], "item_score": state["next"] / self.num_items}
 
 
 SCENARIO = registry.Scenario(

@@ -19,7 +19,7 @@ Metric
 
 from __future__ import annotations
 
-from mjmaze import configs, maze, mjcf, registry
+from mjmaze import configs, maze, mjcf, registry, rules
 from mjmaze.tasks import base
 
 SIZES = (5, 7, 9, 11, 13)
@@ -42,24 +42,23 @@ class Labyrinth(base.MazeTask):
         base._check_choice("size", size, SIZES)
         layout = configs.LayoutSpec(size, CELL_SIZE, maze.DEFAULT_KEEP_PROBABILITY, num_objects=1)
         super().__init__(difficulty=size, layout=layout, **kwargs)
-        self._exit_xy = (0.0, 0.0)
-        self._success = False
 
-    def start_episode(self, physics: base.MazePhysics, config: configs.MazeConfig) -> None:
-        self._exit_xy = config.cell_centre(config.object_cells[0])
-        mocap_ids, geom_ids = physics.object_ids([EXIT.name])
-        physics.place_objects(mocap_ids, self._exit_xy)
-        physics.show_objects(geom_ids, True)
-        self._success = False
+    def start(self, xp, config, keys):
+        batch = keys.shape[0]
+        return {
+            "pose": xp.concat([config["spawn_xy"], self.spawn_yaw(xp, keys)[:, None]], axis=1),
+            "object_xy": config["object_xy"],  # the exit
+            "object_shown": xp.ones((batch, 1), dtype=xp.bool, device=rules.device(keys)),
+            "success": xp.zeros(batch, dtype=xp.bool, device=rules.device(keys)),
+        }
 
-    def scenario_step(self, physics: base.MazePhysics, path) -> tuple[float, bool]:
-        if base.touches(self._exit_xy, path):
-            self._success = True
-            return STEP_REWARD + EXIT_REWARD, True
-        return STEP_REWARD, False
+    def rules(self, xp, state, path):
+        reached = rules.touched(xp, state["object_xy"][:, 0], path)
+        state["success"] = state["success"] | reached
+        return STEP_REWARD + EXIT_REWARD * xp.astype(reached, xp.float64), reached
 
-    def metrics(self) -> dict:
-        return {"success": self._success}
+    def episode_metrics(self, state):
+        return {"success": state["success"]}
 
 
 SCENARIO = registry.Scenario(

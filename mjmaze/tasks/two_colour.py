@@ -33,11 +33,9 @@ Metric
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from mjmaze import configs, mjcf, registry
+from mjmaze import configs, mjcf, registry, rules
 from mjmaze.tasks import base
 
 COMPLEXITIES = tuple(range(0, 11))
@@ -56,8 +54,16 @@ CORRECT_ITEM_REWARD = 1.0
 # Items appear uniformly where the agent can stand: at least its radius from
 # every wall, clear of the totem by both radii, and out of the agent's reach.
 ITEM_WALL_CLEARANCE = base.AGENT_RADIUS
-# Draws per item before giving up (a draw lands on free floor far more often than 1 in 10).
-_MAX_ITEM_DRAWS = 10_000
+# Points tried per item, the first free one kept (see TwoColour._free_positions):
+# a point lands on free floor with probability >= 0.79 (complexity 10, the
+# most walls, measured over generated mazes), so all 32 miss with probability
+# below 1e-21; such an item would not be placed.
+ITEM_CANDIDATES = 32
+_FAR_AWAY = 1e6
+# Sorts after any first_tic * POOL_SIZE + index.
+_NEVER = 1 << 40
+# Elements per array in the item draws' wall test (bounds memory for big batches).
+_CHUNK_ELEMENTS = 1 << 24
 
 RED, GREEN = (0.9, 0.1, 0.1, 1.0), (0.1, 0.8, 0.1, 1.0)
 TOTEM_RADIUS, TOTEM_HEIGHT = 0.125, 1.0
@@ -90,99 +96,168 @@ class TwoColour(base.MazeTask):
         super().__init__(difficulty=complexity, layout=layout, **kwargs)
         self._correct_item_reward = float(correct_item_reward)
         self._item_cap = POOL_SIZE if item_cap is None else item_cap
-        self.item_xy = np.zeros((POOL_SIZE, 2))
-        self.item_green = np.arange(POOL_SIZE) % 2 == 0  # alternating colours, green first
-        self.item_active = np.zeros(POOL_SIZE, dtype=bool)
-        self.items_spawned = 0
-        self.totem_green = False
-        self.health = START_HEALTH
 
-    def spawn_pose(self, config: configs.MazeConfig) -> tuple[float, float, float]:
-        x, y = config.cell_centre(config.spawn_cell)
-        return x, y, 0.0
+    # -- the rules -----------------------------------------------------------
 
-    def start_episode(self, physics: base.MazePhysics, config: configs.MazeConfig) -> None:
-        self._physics = physics
-        self._config = config
-        mocap_ids, geom_ids = physics.object_ids([TOTEM.name] + [item.name for item in ITEMS])
-        self._totem_mocap, self._totem_geom = mocap_ids[0], geom_ids[0]
-        self._item_mocap, self._item_geoms = mocap_ids[1:], geom_ids[1:]
-        self._totem_xy = np.array(config.cell_centre(config.object_cells[0]))
-        self._wall_boxes = mjcf.wall_runs(config.h_walls, config.v_walls, config.cell_size)
-        self._half_extent = config.size * config.cell_size / 2
-        self.totem_green = bool(self.random.rand() < 0.5)
-        physics.place_objects(self._totem_mocap, self._totem_xy)
-        physics.set_object_rgba(self._totem_geom, GREEN if self.totem_green else RED)
-        physics.show_objects(self._totem_geom, True)
-        x, y, _ = physics.agent_pose()
-        self._inside_totem = self._distance_to_totem(x, y) < TOTEM_CLEARANCE
-        physics.set_object_collisions(self._totem_geom, not self._inside_totem)
-        for geom, green in zip(self._item_geoms, self.item_green):
-            physics.set_object_rgba(geom, GREEN if green else RED)
-        physics.show_objects(self._item_geoms, False)
-        self.item_active[:] = False
-        self.items_spawned = 0
-        self.health = START_HEALTH
-        self._spawn_items_due(0, x, y)
+    def config_arrays(self, configs_):
+        arrays = super().config_arrays(configs_)
+        # Each maze's wall boxes (x, y, half x, half y), padded with boxes far
+        # away so that every configuration has as many.
+        runs = [mjcf.wall_runs(config.h_walls, config.v_walls, config.cell_size) for config in configs_]
+        walls = np.tile(np.array([_FAR_AWAY, _FAR_AWAY, 0.0, 0.0]), (len(configs_), max(map(len, runs)), 1))
+        for row, boxes in zip(walls, runs):
+            row[: len(boxes)] = boxes
+        arrays["walls"] = walls
+        return arrays
 
-    def _distance_to_totem(self, x: float, y: float) -> float:
-        return math.hypot(x - self._totem_xy[0], y - self._totem_xy[1])
-
-    def _spawn_items_due(self, tics: int, x: float, y: float) -> None:
-        due = min(2 * START_ITEMS_PER_COLOUR + tics // SPAWN_EVERY_TICS, self._item_cap)
-        while self.items_spawned < due:
-            k = self.items_spawned
-            self.item_xy[k] = self._free_position(x, y)
-            self.item_active[k] = True
-            self._physics.place_objects(self._item_mocap[k], self.item_xy[k])
-            self._physics.show_objects(self._item_geoms[k], True)
-            self.items_spawned += 1
-
-    def _free_position(self, x: float, y: float) -> tuple[float, float]:
-        """A point drawn uniformly over the floor the agent can stand on, out of its reach."""
-        half = self._half_extent
-        wall_x, wall_y, wall_hx, wall_hy = self._wall_boxes.T
-        for _ in range(_MAX_ITEM_DRAWS):
-            px, py = self.random.uniform(-half, half, size=2)
-            # Distance from the point to each wall box (0 inside one).
-            gap_x = np.maximum(np.abs(px - wall_x) - wall_hx, 0.0)
-            gap_y = np.maximum(np.abs(py - wall_y) - wall_hy, 0.0)
-            clear_of_walls = (gap_x * gap_x + gap_y * gap_y).min() >= ITEM_WALL_CLEARANCE**2
-            clear_of_totem = self._distance_to_totem(px, py) >= TOTEM_CLEARANCE
-            if clear_of_walls and clear_of_totem and not base.within_pickup((px, py), x, y):
-                return px, py
-        raise RuntimeError(f"no free floor for an item after {_MAX_ITEM_DRAWS} draws in {self._config!r}")
-
-    def scenario_step(self, physics: base.MazePhysics, path) -> tuple[float, bool]:
-        reward = 0.0
-        tics = np.where(self.item_active, base.reached(self.item_xy, path), -1)
-        picked = np.flatnonzero(tics >= 0)
-        # Items in the order the agent reached them (Doom tests every tic).
-        for k in picked[np.argsort(tics[picked], kind="stable")]:
-            self.item_active[k] = False
-            physics.show_objects(self._item_geoms[k], False)
-            if self.item_green[k] == self.totem_green:
-                raised = min(self.health + ITEM_HEALTH, MAX_HEALTH) > self.health
-                self.health = min(self.health + ITEM_HEALTH, MAX_HEALTH)
-                reward += self._correct_item_reward if raised else 0.0
-            else:
-                self.health -= ITEM_HEALTH
-        self.health -= HEALTH_DECAY_PER_STEP
-        if self.health <= 0:
-            return reward, True
-        x, y = path[-1]
-        if self._inside_totem and self._distance_to_totem(x, y) >= TOTEM_CLEARANCE:
-            self._inside_totem = False  # stepped clear: the totem blocks from now on
-            physics.set_object_collisions(self._totem_geom, True)
-        self._spawn_items_due(self.steps * base.TICS_PER_STEP, x, y)
-        return reward + SURVIVAL_REWARD, False
-
-    def metrics(self) -> dict:
-        return {
-            "duration": self.steps * base.TICS_PER_STEP,
-            "health": self.health,
-            "totem_green": self.totem_green,
+    def start(self, xp, config, keys):
+        batch, device = keys.shape[0], rules.device(keys)
+        totem_xy = config["object_xy"][:, 0]
+        spawn_xy = config["spawn_xy"]
+        totem_green = rules.uniform(xp, keys, rules.DRAW_COLOUR) < 0.5
+        rgba = xp.asarray(np.array([RED, GREEN]), device=device)
+        # Items alternate colours, green first; the totem's is drawn per episode.
+        item_rgba = xp.broadcast_to(rgba[xp.asarray(1 - np.arange(POOL_SIZE) % 2, device=device)], (batch, POOL_SIZE, 4))
+        inside_totem = xp.sum((spawn_xy - totem_xy) ** 2, axis=1) < TOTEM_CLEARANCE**2
+        state = {
+            "pose": xp.concat([spawn_xy, xp.zeros((batch, 1), dtype=xp.float64, device=device)], axis=1),
+            "object_xy": xp.concat([totem_xy[:, None], xp.zeros((batch, POOL_SIZE, 2), dtype=xp.float64, device=device)], axis=1),
+            "object_shown": xp.concat(
+                [xp.ones((batch, 1), dtype=xp.bool, device=device), xp.zeros((batch, POOL_SIZE), dtype=xp.bool, device=device)], axis=1
+            ),
+            "object_rgba": xp.concat([rgba[xp.astype(totem_green, xp.int64)][:, None], item_rgba], axis=1),
+            # The agent may start inside the totem (imported layouts): it does
+            # not block the agent until the agent has stepped clear of it.
+            "object_collides": xp.concat(
+                [~inside_totem[:, None], xp.zeros((batch, POOL_SIZE), dtype=xp.bool, device=device)], axis=1
+            ),
+            "walls": config["walls"],
+            "totem_green": totem_green,
+            "health": xp.full(batch, START_HEALTH, dtype=xp.int64, device=device),
+            "items_spawned": xp.zeros(batch, dtype=xp.int64, device=device),
         }
+        first = min(2 * START_ITEMS_PER_COLOUR, self._item_cap)
+        if first:
+            items = xp.broadcast_to(xp.arange(first, dtype=xp.int64, device=device)[None, :], (batch, first))
+            xy, drawn = self._free_positions(xp, state, keys, items, spawn_xy)
+            state["object_xy"][:, 1 : 1 + first] = xy
+            state["object_shown"][:, 1 : 1 + first] = drawn
+            state["items_spawned"] = state["items_spawned"] + first
+        return state
+
+    def rules(self, xp, state, path):
+        shown, health, totem_green = state["object_shown"], state["health"], state["totem_green"]
+        first_tic = xp.where(shown[:, 1:], rules.first_tic(xp, state["object_xy"][:, 1:], path), -1)
+        picked = first_tic >= 0
+        # Items in the order the agent reached them (Doom tests every tic),
+        # then by index: health is capped, so the order matters.
+        index = xp.arange(POOL_SIZE, dtype=xp.int64, device=rules.device(health))
+        order = xp.argsort(xp.where(picked, first_tic * POOL_SIZE + index, _NEVER), axis=1, stable=True)
+        num_picked = xp.sum(xp.astype(picked, xp.int64), axis=1)
+        reward = xp.zeros(health.shape, dtype=xp.float64, device=rules.device(health))
+        for rank in range(int(xp.max(num_picked))):
+            item = order[:, rank]
+            taken = rank < num_picked
+            correct = taken & ((item % 2 == 0) == totem_green)  # even items are green
+            raised = xp.minimum(health + ITEM_HEALTH, MAX_HEALTH)
+            reward = reward + self._correct_item_reward * xp.astype(correct & (raised > health), xp.float64)
+            health = xp.where(correct, raised, xp.where(taken & ~correct, health - ITEM_HEALTH, health))
+        health = health - HEALTH_DECAY_PER_STEP
+        dead = health <= 0
+        state["health"] = health
+        shown = xp.concat([shown[:, :1], shown[:, 1:] & ~picked], axis=1)
+        # An agent that started inside the totem and stepped clear of it: the totem blocks from now on.
+        agent_xy = path[:, -1]
+        clear = xp.sum((agent_xy - state["object_xy"][:, 0]) ** 2, axis=1) >= TOTEM_CLEARANCE**2
+        collides = state["object_collides"]
+        state["object_collides"] = xp.concat([collides[:, :1] | (clear & ~dead)[:, None], collides[:, 1:]], axis=1)
+        # One item every 30 tics (never more than one per 4-tic step after the start).
+        due = xp.minimum(2 * START_ITEMS_PER_COLOUR + state["steps"] * base.TICS_PER_STEP // SPAWN_EVERY_TICS, self._item_cap)
+        spawn = ~dead & (state["items_spawned"] < due)
+        if bool(xp.any(spawn)):
+            item = state["items_spawned"]
+            xy, drawn = self._free_positions(xp, state, state["key"], item[:, None], agent_xy)
+            slot = rules.one_hot(xp, item + 1, 1 + POOL_SIZE) & (spawn & drawn[:, 0])[:, None]
+            state["object_xy"] = xp.where(slot[:, :, None], xy, state["object_xy"])
+            shown = shown | slot
+            state["items_spawned"] = item + xp.astype(spawn, xp.int64)
+        state["object_shown"] = shown
+        return xp.where(dead, reward, reward + SURVIVAL_REWARD), dead
+
+    def _free_positions(self, xp, state, keys, items, agent_xy):
+        """Where items ``items`` ``(B, K)`` appear: uniform over the floor the agent can stand on, out of its reach.
+
+        Each item tries :data:`ITEM_CANDIDATES` points drawn from the episode's
+        key (``keys`` ``(B,)``) and the item's index and keeps the first that is free; returns
+        ``(xy (B, K, 2), drawn (B, K))``, ``drawn`` false where none was.
+        """
+        batch, count = items.shape
+        device = rules.device(items)
+        candidate = xp.arange(ITEM_CANDIDATES, dtype=xp.int64, device=device)[None, None, :, None]
+        axis = xp.arange(2, dtype=xp.int64, device=device)[None, None, None, :]
+        half = GRID_SIZE * CELL_SIZE / 2
+        walls = state["walls"][:, None, None, :, :]  # (B, 1, 1, W, 4)
+        totem_xy = state["object_xy"][:, 0][:, None, None, :]
+        # In chunks of items: the wall test is (B, K, candidates, W).
+        per_item = batch * ITEM_CANDIDATES * state["walls"].shape[1]
+        chunk = max(1, _CHUNK_ELEMENTS // max(per_item, 1))
+        xys, drawns = [], []
+        for begin in range(0, count, chunk):
+            part = items[:, begin : begin + chunk]
+            u = rules.uniform(xp, keys[:, None, None, None], rules.DRAW_ITEM, part[:, :, None, None], candidate, axis)
+            points = (2 * u - 1) * half  # (B, k, candidates, 2)
+            gap_x = xp.clip(xp.abs(points[..., 0:1] - walls[..., 0]) - walls[..., 2], min=0.0)
+            gap_y = xp.clip(xp.abs(points[..., 1:2] - walls[..., 1]) - walls[..., 3], min=0.0)
+            free = (
+                (xp.min(gap_x * gap_x + gap_y * gap_y, axis=-1) >= ITEM_WALL_CLEARANCE**2)
+                & (xp.sum((points - totem_xy) ** 2, axis=-1) >= TOTEM_CLEARANCE**2)
+                & (xp.sum((points - agent_xy[:, None, None, :]) ** 2, axis=-1) >= base.PICKUP_RADIUS**2)
+            )
+            first = rules.one_hot(xp, xp.reshape(xp.argmax(xp.astype(free, xp.int8), axis=-1), (-1,)), ITEM_CANDIDATES)
+            first = xp.reshape(first, free.shape)
+            xys.append(xp.sum(points * xp.astype(first, xp.float64)[..., None], axis=2))
+            drawns.append(xp.any(free, axis=-1))
+        return xp.concat(xys, axis=1), xp.concat(drawns, axis=1)
+
+    def episode_metrics(self, state):
+        return {
+            "duration": state["steps"] * base.TICS_PER_STEP,
+            "health": state["health"],
+            "totem_green": state["totem_green"],
+        }
+
+    # -- the episode's state, for tests and analysis (batch of one) ----------
+
+    @property
+    def item_xy(self) -> np.ndarray:
+        """``(POOL_SIZE, 2)``: where each item of the pool is (a view: writes move them)."""
+        return self.state["object_xy"][0, 1:]
+
+    @property
+    def item_active(self) -> np.ndarray:
+        """``(POOL_SIZE,)``: which items are on the floor (a view)."""
+        return self.state["object_shown"][0, 1:]
+
+    @property
+    def item_green(self) -> np.ndarray:
+        """``(POOL_SIZE,)``: the items' colours, alternating, green first."""
+        return np.arange(POOL_SIZE) % 2 == 0
+
+    @property
+    def items_spawned(self) -> int:
+        return int(self.state["items_spawned"][0])
+
+    @property
+    def totem_green(self) -> bool:
+        return bool(self.state["totem_green"][0])
+
+    @property
+    def health(self) -> int:
+        return int(self.state["health"][0])
+
+    @health.setter
+    def health(self, value: int) -> None:
+        self.state["health"][0] = value
 
 
 SCENARIO = registry.Scenario(

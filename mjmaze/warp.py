@@ -1,0 +1,376 @@
+"""MuJoCo Warp batch backend: thousands of mazes stepped and rendered at once on one device.
+
+``MazeBatchEnv(num_envs, scenario, device="cuda", **task_kwargs)`` is a
+gymnasium vector env whose observations, rewards, flags and ``info`` are torch
+tensors on ``device``; reached from the registry by one word::
+
+    envs = gymnasium.make_vec("mjmaze/Labyrinth-v0", num_envs=4096,
+                              vectorization_mode="vector_entry_point", backend="warp", size=9)
+
+It plays the same task as the CPU envs: the same configurations (splits,
+``num_configs``, imported layouts), the scenario's own rules
+(:meth:`mjmaze.tasks.base.MazeTask.start` and
+:meth:`~mjmaze.tasks.base.MazeTask.rules`, called here on torch tensors with a
+batch of all envs), the same agent motion
+(:func:`mjmaze.tasks.base.agent_velocity`) and the same per-tic speculative
+contacts; env ``i`` seeded with ``s`` plays the same episodes as a CPU env
+seeded with ``s``. Warp computes in float32, so long runs drift apart by
+rounding (tests/test_warp.py checks the first 100 steps and outcome statistics).
+
+How one model holds a maze per world (facts in ``docs/warp_backend.md``): in
+MuJoCo Warp a per-world ``geom_pos`` moves only geoms of a body, and contact
+types are shared by all worlds. So every wall box, the wall mesh and every
+object sit in one mocap body at the origin; per world, a box of an absent wall
+or a hidden object is moved below the floor (``geom_pos``), the wall mesh is
+chosen among one mesh per wall layout (``geom_dataid``), and objects are
+coloured by ``geom_rgba``. An object that collides has a second, invisible
+geom for contacts, moved away where it must not block (Two-colour's totem
+while the agent stands inside it).
+
+Install with ``pip install "mjmaze[warp]"``; importing :mod:`mjmaze` never
+imports Warp or torch, only this module does.
+"""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+from typing import Any
+
+import gymnasium as gym
+import mujoco
+import numpy as np
+import torch
+from gymnasium.vector import AutoresetMode
+from gymnasium.vector.utils import batch_space
+
+import mujoco_warp as mjw
+import warp as wp
+from mjmaze import mjcf, rules, suite
+from mjmaze.tasks import base
+
+# Where a geom that must not be seen or touched in a world goes (below the floor).
+_AWAY_Z = -50.0
+# Contacts and constraint rows a world can hold: the agent (a sphere) touches
+# at most a corner's few wall boxes and a pillar at once.
+_CONTACTS_PER_WORLD = 16
+_ARENA_BODY = "arena"
+_COLLISION_SUFFIX = "_collision"
+
+
+def build_model(task: base.MazeTask) -> tuple[mujoco.MjModel, np.ndarray, np.ndarray]:
+    """The task's arena as one MuJoCo model for all worlds, with a wall mesh per layout.
+
+    Returns ``(model, mesh_of_config (C,), box_z_of_config (C, boxes))``: which
+    mesh draws configuration ``c``'s walls and where its wall boxes stand (an
+    absent wall's box below the floor).
+    """
+    layout = task.layout
+    root = ET.fromstring(mjcf.build_xml(layout.grid_size, layout.cell_size, task.objects, task.visual_style))
+    worldbody, asset = root.find("worldbody"), root.find("asset")
+    arena = ET.SubElement(worldbody, "body", name=_ARENA_BODY, mocap="true", pos="0 0 0")
+    # One mesh per distinct wall layout among the task's configurations.
+    all_configs = [task.configs[i] for i in range(len(task.configs))]
+    layouts: dict[bytes, int] = {}
+    mesh_of_config = np.array([layouts.setdefault(c.layout_key(), len(layouts)) for c in all_configs], dtype=np.int32)
+    first_of_layout = {}
+    for config, mesh in zip(all_configs, mesh_of_config):
+        first_of_layout.setdefault(int(mesh), config)
+    asset.remove(asset.find(f"mesh[@name='{mjcf.WALL_MESH}']"))
+    for mesh, config in first_of_layout.items():
+        quads = mjcf.wall_mesh_quads(config.h_walls, config.v_walls, layout.cell_size)
+        mjcf.add_placeholder_mesh(asset, f"{mjcf.WALL_MESH}_{mesh}", quads)
+    for geom in list(worldbody.findall("geom")):
+        name = geom.get("name", "")
+        if name == "walls_visual":
+            geom.set("mesh", f"{mjcf.WALL_MESH}_0")
+        elif name in ("floor",):
+            continue
+        worldbody.remove(geom)
+        arena.append(geom)
+    for obj in task.objects:  # every object in the arena body, drawn; hidden = moved away
+        body = worldbody.find(f"body[@name='{obj.name}']")
+        if body is not None:  # a colliding object's own mocap body
+            worldbody.remove(body)
+            geom = body.find("geom")
+            geom.set("pos", f"0 0 {obj.z}")
+            arena.append(geom)
+        geom = arena.find(f"geom[@name='{obj.name}']")
+        geom.set("group", str(base.VISIBLE_GROUP))
+        if obj.collides:
+            geom.set("contype", "0")
+            geom.set("conaffinity", "0")
+            twin = ET.SubElement(arena, "geom", dict(geom.attrib))
+            twin.set("name", obj.name + _COLLISION_SUFFIX)
+            twin.set("group", "3")
+            twin.set("contype", "1")
+            twin.set("conaffinity", "1")
+    model = mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
+    mjcf.paint_textures(model)
+    for mesh, config in first_of_layout.items():
+        mesh_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MESH, f"{mjcf.WALL_MESH}_{mesh}")
+        mjcf.write_wall_mesh(model, mesh_id, config.h_walls, config.v_walls, layout.cell_size)
+    visual = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "walls_visual")
+    model.geom_pos[visual] = 0.0  # mesh vertices are in world coordinates
+    model.geom_quat[visual] = (1.0, 0.0, 0.0, 0.0)
+    segments = mjcf.wall_segments(layout.grid_size, layout.cell_size)
+    present = np.array([np.concatenate([c.h_walls.ravel(), c.v_walls.ravel()]) for c in all_configs], dtype=bool)
+    box_z = np.where(present, mjcf.WALL_HEIGHT / 2, _AWAY_Z).astype(np.float32)
+    assert box_z.shape[1] == len(segments)
+    return model, mesh_of_config, box_z
+
+
+class MazeBatchEnv(gym.vector.VectorEnv):
+    """``num_envs`` envs of a scenario in one MuJoCo Warp model on ``device``; see the module docstring.
+
+    Args:
+      num_envs: how many envs (worlds).
+      scenario: a registered scenario's name.
+      device: a Warp/torch device: ``"cuda"``, ``"cuda:1"`` or ``"cpu"`` (slow;
+        for tests).
+      autoreset_mode: ``"next_step"`` only (the CPU vector env's default): an
+        env that ended is reset on its next step, whose action is ignored, with
+        reward 0 and both flags false.
+      render_segmentation: also render per-pixel geom ids (:meth:`segmentation`), for tests.
+      **task_kwargs: the scenario's task arguments, as for the CPU envs. Env
+        ``i`` cycles through the configurations from its own offset, as in
+        :class:`mjmaze.vector.MazeVectorEnv`.
+
+    ``reset(seed=s)`` seeds env ``i`` with ``s + i`` (a list gives each its own).
+    """
+
+    def __init__(
+        self,
+        num_envs: int,
+        scenario: str = suite.DEFAULT_SCENARIO,
+        device: str = "cuda",
+        autoreset_mode: str | AutoresetMode = "next_step",
+        render_segmentation: bool = False,
+        **task_kwargs: Any,
+    ):
+        if not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
+            raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
+        if autoreset_mode not in ("next_step", AutoresetMode.NEXT_STEP):
+            raise ValueError(
+                f"the Warp backend resets envs on the next step only (autoreset_mode='next_step'), got {autoreset_mode!r}"
+            )
+        if str(device).startswith("cuda") and not torch.cuda.is_available():
+            raise RuntimeError("device='cuda' but torch sees no CUDA GPU; pass device='cpu' (slow) or install a CUDA torch")
+        # At its default level Warp prints a line per kernel module it loads (hundreds).
+        wp.config.log_level = max(wp.config.log_level, wp.LOG_WARNING)
+        wp.init()
+        first = int(task_kwargs.pop("first_config", 0))
+        self.task = task = suite.make_task(scenario, task_kwargs)
+        self.scenario = scenario
+        self.num_envs = n = int(num_envs)
+        self.device = torch.device(device)
+        self._wp_device = wp.get_device(str(device))
+        self.xp = rules.namespace(torch.zeros(1))
+        height, width = task.height, task.width
+        self.metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": [], "render_fps": 35 / 4}
+        self.render_mode = None
+        self.single_observation_space = gym.spaces.Box(0, 255, (height, width, 3), np.uint8)
+        self.single_action_space = gym.spaces.Discrete(len(task.actions))
+        self.observation_space = batch_space(self.single_observation_space, n)
+        self.action_space = batch_space(self.single_action_space, n)
+        self.closed = False
+
+        mjm, mesh_of_config, box_z = build_model(task)
+        self._host_model = mjm
+        dev = self.device
+        table = task.config_arrays([task.configs[i] for i in range(len(task.configs))])
+        self._config_table = {name: torch.as_tensor(value, device=dev) for name, value in table.items()}
+        self._mesh_of_config = torch.as_tensor(mesh_of_config, device=dev)
+        self._box_z = torch.as_tensor(box_z, device=dev)
+        num_configs = len(task.configs)
+        self._first = torch.tensor([(first + i * num_configs // n) % num_configs for i in range(n)], device=dev)
+
+        def geom(name: str) -> int:
+            return mujoco.mj_name2id(mjm, mujoco.mjtObj.mjOBJ_GEOM, name)
+
+        first_box = geom("wall_0")
+        self._box_ids = torch.arange(first_box, first_box + box_z.shape[1], device=dev)
+        self._wall_visual = geom("walls_visual")
+        self._object_ids = torch.tensor([geom(obj.name) for obj in task.objects], dtype=torch.long, device=dev)
+        self._object_z = torch.tensor([obj.z for obj in task.objects], dtype=torch.float32, device=dev)
+        colliding = [k for k, obj in enumerate(task.objects) if obj.collides]
+        self._colliding = torch.tensor(colliding, dtype=torch.long, device=dev)
+        self._collision_ids = torch.tensor(
+            [geom(task.objects[k].name + _COLLISION_SUFFIX) for k in colliding], dtype=torch.long, device=dev
+        )
+        self._timestep = float(mjm.opt.timestep)
+        self._actions = torch.tensor(task.actions, dtype=torch.float64, device=dev)  # (A, 2): forward, turn
+
+        with wp.ScopedDevice(self._wp_device):
+            self._model = mjw.put_model(mjm, batch_sizes={"geom_pos": n, "geom_rgba": n, "geom_dataid": n})
+            self._data = mjw.put_data(mjm, mujoco.MjData(mjm), nworld=n, nconmax=_CONTACTS_PER_WORLD, njmax=_CONTACTS_PER_WORLD)
+            self._render = mjw.create_render_context(
+                mjm, nworld=n, cam_res=(width, height), render_rgb=True, render_depth=False,
+                render_seg=render_segmentation, use_textures=True, cam_active=[base.CAMERA],
+                enabled_geom_groups=[0, 1, 2],
+            )
+        self._segmentation = render_segmentation
+        # Torch views of the Warp arrays (no copies): what the env writes and reads.
+        self._qpos = wp.to_torch(self._data.qpos)
+        self._qvel = wp.to_torch(self._data.qvel)
+        self._warmstart = wp.to_torch(self._data.qacc_warmstart)
+        self._geom_pos = wp.to_torch(self._model.geom_pos)
+        self._geom_rgba = wp.to_torch(self._model.geom_rgba)
+        self._geom_dataid = wp.to_torch(self._model.geom_dataid)
+        self._rgb_packed = wp.to_torch(self._render.rgb_data)
+        self._stream = wp.stream_from_torch(torch.cuda.current_stream(dev)) if dev.type == "cuda" else None
+
+        self._seed_keys = torch.zeros(n, dtype=torch.int64, device=dev)
+        self._episodes = torch.zeros(n, dtype=torch.int64, device=dev)
+        self._config_index = torch.zeros(n, dtype=torch.int64, device=dev)
+        self._returns = torch.zeros(n, dtype=torch.float64, device=dev)
+        self._ended = torch.zeros(n, dtype=torch.bool, device=dev)
+        self._path = torch.zeros((n, base.TICS_PER_STEP, 2), dtype=torch.float64, device=dev)
+        self._obs = torch.zeros((n, height, width, 3), dtype=torch.uint8, device=dev)
+        self.state: dict[str, torch.Tensor] | None = None
+        self._info_fields = task.info_fields()
+
+    # -- gymnasium API ------------------------------------------------------
+
+    def reset(self, *, seed: int | list[int] | None = None, options: dict | None = None):
+        """Starts a new episode in every env; returns ``(observations, infos)`` on the device."""
+        n = self.num_envs
+        if seed is None:
+            keys = np.random.default_rng().integers(1 << 32, size=n)
+        else:
+            seeds = [int(seed) + i for i in range(n)] if isinstance(seed, (int, np.integer)) else [int(s) for s in seed]
+            if len(seeds) != n:
+                raise ValueError(f"reset needs one seed per env ({n}), got {len(seeds)}")
+            keys = np.array([rules.seed_key(np.random.RandomState(s)) for s in seeds])
+        self._seed_keys.copy_(torch.as_tensor(keys, dtype=torch.int64))
+        self._episodes.zero_()
+        with self._warp_stream():
+            self._start_episodes(torch.arange(n, device=self.device))
+            self._draw()
+        self._ended.zero_()
+        return self._obs.clone(), self._infos()
+
+    def step(self, actions):
+        """One agent step in every env: ``(observations, rewards, terminated, truncated, infos)``, torch tensors."""
+        xp, task = self.xp, self.task
+        actions = torch.as_tensor(actions, device=self.device).long()
+        ended_before = self._ended.clone()
+        with self._warp_stream():
+            forward, turn = self._actions[actions, 0], self._actions[actions, 1]
+            vx, vy, wz = base.agent_velocity(xp, forward, turn, self._qpos[:, 2].double(), self._timestep)
+            self._qvel[:, 0], self._qvel[:, 1], self._qvel[:, 2] = vx, vy, wz
+            self._advance_physics()
+            reward, terminated, truncated = task.step_state(xp, self.state, self._path)
+            self._place_objects(self.state)
+            self._returns += reward
+            # Next-step autoreset: envs that ended on the previous step start anew.
+            reward = torch.where(ended_before, 0.0, reward)
+            terminated = terminated & ~ended_before
+            truncated = truncated & ~ended_before
+            restart = torch.nonzero(ended_before).flatten()
+            if len(restart):
+                self._start_episodes(restart)
+            self._draw()
+        self._ended = terminated | truncated
+        return self._obs.clone(), reward.float(), terminated, truncated, self._infos()
+
+    def close_extras(self, **kwargs: Any) -> None:
+        self.state = None
+
+    # -- what the env does per step ------------------------------------------
+
+    def _warp_stream(self):
+        """Warp kernels go on torch's current stream: no synchronisation between the two."""
+        if self._stream is None:
+            return wp.ScopedDevice(self._wp_device)
+        return wp.ScopedStream(self._stream)
+
+    def _advance_physics(self) -> None:
+        """The step's tics with speculative contacts, as :meth:`mjmaze.tasks.base.MazePhysics.step`."""
+        qpos, qvel, dt = self._qpos, self._qvel, self._timestep
+        for tic in range(base.TICS_PER_STEP):
+            ahead = qvel[:, :2] * dt
+            qpos[:, :2] += ahead
+            mjw.step(self._model, self._data)
+            qpos[:, :2] -= ahead
+            self._path[:, tic] = qpos[:, :2]
+
+    def _start_episodes(self, envs: torch.Tensor) -> None:
+        """New episodes in ``envs`` (indices): configuration, the scenario's start, the arena."""
+        xp, task = self.xp, self.task
+        episodes = self._episodes[envs]
+        keys = task.episode_keys(xp, self._seed_keys[envs], episodes)
+        config_index = task.config_indices(xp, keys, episodes, first=self._first[envs])
+        self._episodes[envs] = episodes + 1
+        self._config_index[envs] = config_index
+        start = task.start_state(xp, {name: value[config_index] for name, value in self._config_table.items()}, keys)
+        if self.state is None or len(envs) == self.num_envs:
+            self.state = start
+        else:
+            for name, value in start.items():
+                self.state[name][envs] = value
+        self._returns[envs] = 0.0
+        pose = start["pose"]
+        self._qpos[envs, 0:3] = pose.float()
+        self._qvel[envs] = 0.0
+        self._warmstart[envs] = 0.0
+        # The maze: its wall boxes, its wall mesh.
+        geom_pos = self._geom_pos
+        rows = envs[:, None]
+        geom_pos[rows, self._box_ids[None, :], 2] = self._box_z[config_index]
+        self._geom_dataid[envs, self._wall_visual] = self._mesh_of_config[config_index].int()
+        if "object_rgba" in start:
+            self._geom_rgba[rows, self._object_ids[None, :]] = start["object_rgba"].float()
+        self._place_objects(self.state)
+
+    def _place_objects(self, state: dict) -> None:
+        """Moves every world's objects where ``state`` says; hidden or non-blocking ones below the floor."""
+        shown = state["object_shown"]
+        xy = torch.where(shown[..., None], state["object_xy"], 0.0).float()
+        pos = self._geom_pos
+        ids = self._object_ids
+        pos[:, ids, 0:2] = xy
+        pos[:, ids, 2] = torch.where(shown, self._object_z, _AWAY_Z)
+        if len(self._colliding):
+            blocks = shown[:, self._colliding]
+            if "object_collides" in state:
+                blocks = blocks & state["object_collides"][:, self._colliding]
+            pos[:, self._collision_ids, 0:2] = xy[:, self._colliding]
+            pos[:, self._collision_ids, 2] = torch.where(blocks, self._object_z[self._colliding], _AWAY_Z)
+
+    def _draw(self) -> None:
+        """Renders every world's ego view into the observations."""
+        m, d, rc = self._model, self._data, self._render
+        mjw.kinematics(m, d)  # positions lag a step behind mjw.step's integration
+        mjw.camlight(m, d)
+        mjw.refit_bvh(m, d, rc)
+        mjw.render(m, d, rc)
+        # Packed 0xAABBGGRR per pixel: bytes R, G, B, A in memory.
+        packed = self._rgb_packed.view(torch.uint8).view(self.num_envs, self.task.height, self.task.width, 4)
+        self._obs.copy_(packed[..., [2, 1, 0]])
+
+    def segmentation(self) -> torch.Tensor:
+        """``(N, H, W)`` geom id drawn at each pixel of the last frames, -1 for none (needs ``render_segmentation``)."""
+        if not self._segmentation:
+            raise RuntimeError("create the env with render_segmentation=True to read segmentation")
+        seg = wp.to_torch(self._render.seg_data).view(self.num_envs, self.task.height, self.task.width, 2)
+        return torch.where(seg[..., 1] == int(mujoco.mjtObj.mjOBJ_GEOM), seg[..., 0], -1)
+
+    def _infos(self) -> dict:
+        task, state = self.task, self.state
+        qpos = self._qpos.double()
+        fields = dict(task.episode_metrics(state))
+        fields.update(
+            x=qpos[:, 0], y=qpos[:, 1], yaw=qpos[:, 2] - math.tau * torch.round(qpos[:, 2] / math.tau),
+            step=state["steps"], episode_return=self._returns.clone(), config_index=self._config_index.clone(),
+        )
+        everyone = torch.ones(self.num_envs, dtype=torch.bool, device=self.device)
+        infos = {}
+        for name in self._info_fields:
+            infos[name] = fields[name].clone()
+            infos[f"_{name}"] = everyone
+        return infos
+
+    def __repr__(self) -> str:
+        return f"MazeBatchEnv({self.scenario!r}, num_envs={self.num_envs}, device={str(self.device)!r})"
+
