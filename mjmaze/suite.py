@@ -26,7 +26,7 @@ def register(scenario: registry.Scenario) -> registry.Scenario:
         gymnasium.register(
             id=scenario.gym_id,
             entry_point="mjmaze.gym_env:MazeEnv",
-            vector_entry_point="mjmaze.vector:MazeVectorEnv",
+            vector_entry_point="mjmaze.vector:make_vector_env",
             kwargs={"scenario": scenario.name},
         )
     return scenario

@@ -165,6 +165,25 @@ class _EnvGroup:
         self._envs = []
 
 
+def make_vector_env(num_envs: int, scenario: str = suite.DEFAULT_SCENARIO, backend: str = "cpu", **kwargs: Any):
+    """The vector env of ``backend``, what ``gymnasium.make_vec(..., vectorization_mode="vector_entry_point")`` builds.
+
+    ``"cpu"``: :class:`MazeVectorEnv` (worker processes, numpy arrays);
+    ``"warp"``: :class:`mjmaze.warp.MazeBatchEnv` (every env in one MuJoCo Warp
+    model on a GPU, torch tensors; ``pip install "mjmaze[warp]"``). ``kwargs``
+    go to the chosen class (its options and the scenario's task arguments).
+    """
+    if backend == "cpu":
+        return MazeVectorEnv(num_envs, scenario, **kwargs)
+    if backend == "warp":
+        try:
+            from mjmaze.warp import MazeBatchEnv
+        except ImportError as error:
+            raise ImportError(f'backend="warp" needs MuJoCo Warp and torch: pip install "mjmaze[warp]" ({error})') from None
+        return MazeBatchEnv(num_envs, scenario, **kwargs)
+    raise ValueError(f"backend must be 'cpu' or 'warp', got {backend!r}")
+
+
 def _poll_then_block(conn, poll_seconds: float) -> None:
     """Returns once ``conn`` can be read: polls for up to ``poll_seconds``, then sleeps.
 

@@ -128,9 +128,15 @@ class MazeBatchEnv(gym.vector.VectorEnv):
       scenario: a registered scenario's name.
       device: a Warp/torch device: ``"cuda"``, ``"cuda:1"`` or ``"cpu"`` (slow;
         for tests).
-      autoreset_mode: ``"next_step"`` only (the CPU vector env's default): an
-        env that ended is reset on its next step, whose action is ignored, with
-        reward 0 and both flags false.
+      autoreset_mode: as for :class:`mjmaze.vector.MazeVectorEnv`: ``"next_step"``
+        (default; an env that ended is reset on its next step, whose action is
+        ignored, with reward 0 and both flags false) or ``"same_step"`` (reset at
+        once; ``infos["final_info"]`` holds the ended episodes' last info and
+        ``infos["final_obs"]`` their last frames).
+      keep_final_obs: in ``"same_step"`` mode, render the ended episodes' last
+        frames for ``infos["final_obs"]`` (default). Every world is drawn at
+        once, so this is a second render on every step where any env ends:
+        pass False when the last frames are not needed (``mjmaze.train.a2c``).
       render_segmentation: also render per-pixel geom ids (:meth:`segmentation`), for tests.
       **task_kwargs: the scenario's task arguments, as for the CPU envs. Env
         ``i`` cycles through the configurations from its own offset, as in
@@ -145,15 +151,18 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         scenario: str = suite.DEFAULT_SCENARIO,
         device: str = "cuda",
         autoreset_mode: str | AutoresetMode = "next_step",
+        keep_final_obs: bool = True,
         render_segmentation: bool = False,
         **task_kwargs: Any,
     ):
         if not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
             raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
-        if autoreset_mode not in ("next_step", AutoresetMode.NEXT_STEP):
-            raise ValueError(
-                f"the Warp backend resets envs on the next step only (autoreset_mode='next_step'), got {autoreset_mode!r}"
-            )
+        modes = {"next_step": AutoresetMode.NEXT_STEP, "same_step": AutoresetMode.SAME_STEP}
+        mode = autoreset_mode if isinstance(autoreset_mode, AutoresetMode) else modes.get(autoreset_mode)
+        if mode not in modes.values():
+            raise ValueError(f"autoreset_mode must be one of {tuple(modes)}, got {autoreset_mode!r}")
+        self.autoreset_mode = mode
+        self._keep_final_obs = bool(keep_final_obs)
         if str(device).startswith("cuda") and not torch.cuda.is_available():
             raise RuntimeError("device='cuda' but torch sees no CUDA GPU; pass device='cpu' (slow) or install a CUDA torch")
         # At its default level Warp prints a line per kernel module it loads (hundreds).
@@ -167,7 +176,7 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         self._wp_device = wp.get_device(str(device))
         self.xp = rules.namespace(torch.zeros(1))
         height, width = task.height, task.width
-        self.metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": [], "render_fps": 35 / 4}
+        self.metadata = {"autoreset_mode": mode, "render_modes": [], "render_fps": 35 / 4}
         self.render_mode = None
         self.single_observation_space = gym.spaces.Box(0, 255, (height, width, 3), np.uint8)
         self.single_action_space = gym.spaces.Discrete(len(task.actions))
@@ -263,16 +272,32 @@ class MazeBatchEnv(gym.vector.VectorEnv):
             reward, terminated, truncated = task.step_state(xp, self.state, self._path)
             self._place_objects(self.state)
             self._returns += reward
-            # Next-step autoreset: envs that ended on the previous step start anew.
-            reward = torch.where(ended_before, 0.0, reward)
-            terminated = terminated & ~ended_before
-            truncated = truncated & ~ended_before
-            restart = torch.nonzero(ended_before).flatten()
+            if self.autoreset_mode == AutoresetMode.NEXT_STEP:
+                # Envs that ended on the previous step start anew; this step's action is ignored.
+                reward = torch.where(ended_before, 0.0, reward)
+                terminated = terminated & ~ended_before
+                truncated = truncated & ~ended_before
+                restart = torch.nonzero(ended_before).flatten()
+                final = {}
+            else:
+                restart = torch.nonzero(terminated | truncated).flatten()
+                final = self._final_infos(terminated | truncated) if len(restart) else {}
             if len(restart):
                 self._start_episodes(restart)
             self._draw()
         self._ended = terminated | truncated
-        return self._obs.clone(), reward.float(), terminated, truncated, self._infos()
+        infos = self._infos()
+        infos.update(final)
+        return self._obs.clone(), reward.float(), terminated, truncated, infos
+
+    def _final_infos(self, ended: torch.Tensor) -> dict:
+        """``final_info`` (and ``final_obs``) of the envs that just ended, before they are reset."""
+        final = {"final_info": self._infos(mask=ended), "_final_info": ended}
+        if self._keep_final_obs:
+            self._draw()
+            final["final_obs"] = self._obs.clone()
+            final["_final_obs"] = ended
+        return final
 
     def close_extras(self, **kwargs: Any) -> None:
         self.state = None
@@ -356,7 +381,8 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         seg = wp.to_torch(self._render.seg_data).view(self.num_envs, self.task.height, self.task.width, 2)
         return torch.where(seg[..., 1] == int(mujoco.mjtObj.mjOBJ_GEOM), seg[..., 0], -1)
 
-    def _infos(self) -> dict:
+    def _infos(self, mask: torch.Tensor | None = None) -> dict:
+        """The info fields of every env (tensors ``(N,)``), each with its ``_field`` mask (``mask``, default all)."""
         task, state = self.task, self.state
         qpos = self._qpos.double()
         fields = dict(task.episode_metrics(state))
@@ -364,11 +390,12 @@ class MazeBatchEnv(gym.vector.VectorEnv):
             x=qpos[:, 0], y=qpos[:, 1], yaw=qpos[:, 2] - math.tau * torch.round(qpos[:, 2] / math.tau),
             step=state["steps"], episode_return=self._returns.clone(), config_index=self._config_index.clone(),
         )
-        everyone = torch.ones(self.num_envs, dtype=torch.bool, device=self.device)
+        if mask is None:
+            mask = torch.ones(self.num_envs, dtype=torch.bool, device=self.device)
         infos = {}
         for name in self._info_fields:
             infos[name] = fields[name].clone()
-            infos[f"_{name}"] = everyone
+            infos[f"_{name}"] = mask
         return infos
 
     def __repr__(self) -> str:

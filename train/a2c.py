@@ -35,7 +35,7 @@ import tyro
 from torch.nn import functional as F
 
 from mjmaze import files, suite
-from mjmaze.vector import MazeVectorEnv, WorkerError
+from mjmaze.vector import WorkerError, make_vector_env
 
 from . import checkpoint
 from .model import Agent
@@ -100,9 +100,16 @@ def train(args: Args) -> pathlib.Path:
     if args.torch_threads:
         torch.set_num_threads(args.torch_threads)
     torch.manual_seed(args.seed)
+    if args.backend == "warp":
+        # The envs live on the network's device: observations never leave it.
+        options = dict(device=str(device), keep_final_obs=False)
+    elif args.backend == "cpu":
+        options = dict(num_workers=args.num_workers, copy=False)
+    else:
+        raise ValueError(f"--backend must be cpu or warp, got {args.backend!r}")
     make_envs = functools.partial(
-        MazeVectorEnv, args.num_envs, args.scenario, num_workers=args.num_workers, autoreset_mode="same_step",
-        copy=False, split="train", **task_kwargs,
+        make_vector_env, args.num_envs, args.scenario, backend=args.backend, autoreset_mode="same_step",
+        split="train", **options, **task_kwargs,
     )
     envs = make_envs()
     try:
@@ -127,13 +134,15 @@ def _loop(args, make_envs, envs, agent, optimizer, device, run_dir, step, update
 
     n, T = args.num_envs, args.num_steps
     metric, scale, _ = suite.paper_metric(args.scenario)
-    actions = torch.zeros((T, n), dtype=torch.long)
-    rewards = torch.zeros((T, n))
-    dones = torch.zeros((T, n))
+    # Rollout buffers where the envs put their results (the GPU with the Warp backend).
+    buffers = device if args.backend == "warp" else torch.device("cpu")
+    actions = torch.zeros((T, n), dtype=torch.long, device=buffers)
+    rewards = torch.zeros((T, n), device=buffers)
+    dones = torch.zeros((T, n), device=buffers)
 
     obs, _ = envs.reset(seed=args.seed + 1000 * update)
     hidden = agent.initial_state(n, device)
-    episode_starts = torch.ones(n, dtype=torch.bool)
+    episode_starts = torch.ones(n, dtype=torch.bool, device=buffers)
     writer = SummaryWriter(run_dir / "tensorboard")
     metrics_file = open(run_dir / "metrics.jsonl", "a")
     next_checkpoint = (step // args.checkpoint_every + 1) * args.checkpoint_every
@@ -156,22 +165,25 @@ def _loop(args, make_envs, envs, agent, optimizer, device, run_dir, step, update
                     # not change within a rollout, so its graph is kept for the
                     # backward pass instead of being recomputed (the same gradients;
                     # tests/test_train.py checks it). The graph holds ~90 KB per frame.
-                    features = agent.features(torch.from_numpy(obs).to(device))
+                    features = agent.features(torch.as_tensor(obs).to(device))
                     logits, value, hidden = agent.step(features, hidden, episode_starts.to(device))
                     step_logits.append(logits)
                     step_values.append(value)
                     with torch.no_grad():
                         action = torch.multinomial(F.softmax(logits, dim=-1), 1).squeeze(1)
                     env_started = time.perf_counter()
-                    obs, reward, terminated, truncated, infos = envs.step(action.cpu().numpy())
+                    action = action.to(buffers)
+                    obs, reward, terminated, truncated, infos = envs.step(action if args.backend == "warp" else action.numpy())
                     env_seconds += time.perf_counter() - env_started
-                    ended = terminated | truncated
-                    actions[t] = action.cpu()
-                    rewards[t] = torch.from_numpy(reward)
-                    dones[t] = torch.from_numpy(ended.astype(np.float32))
-                    episode_starts = torch.from_numpy(ended)
-                    for i in np.flatnonzero(ended):
-                        finished.append({k: v[i] for k, v in infos["final_info"].items() if not k.startswith("_")})
+                    ended = torch.as_tensor(terminated | truncated)
+                    actions[t] = action
+                    rewards[t] = torch.as_tensor(reward)
+                    dones[t] = ended
+                    episode_starts = ended
+                    if "final_info" in infos:
+                        final = {k: v for k, v in infos["final_info"].items() if not k.startswith("_")}
+                        for i in torch.nonzero(ended).flatten().tolist():
+                            finished.append({k: v[i].item() for k, v in final.items()})
             except WorkerError as error:
                 # The network and optimizer are intact: drop this rollout (its
                 # episodes are cut), rebuild the envs and start fresh episodes.
@@ -190,12 +202,12 @@ def _loop(args, make_envs, envs, agent, optimizer, device, run_dir, step, update
                 rebuilds += 1
                 obs, _ = envs.reset(seed=args.seed + 1000 * update + rebuilds)
                 hidden = agent.initial_state(n, device)
-                episode_starts = torch.ones(n, dtype=torch.bool)
+                episode_starts = torch.ones(n, dtype=torch.bool, device=buffers)
                 continue
             failures = 0
             update_started = time.perf_counter()
             with torch.no_grad():
-                features = agent.features(torch.from_numpy(obs).to(device))
+                features = agent.features(torch.as_tensor(obs).to(device))
                 _, last_value, _ = agent.step(features, hidden, episode_starts.to(device))
             torch.set_num_threads(update_threads)
             returns = n_step_returns(rewards.to(device), dones.to(device), last_value, args.gamma)

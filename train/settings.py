@@ -49,6 +49,8 @@ class _RunSettings:
     """env worker processes beside the training process, which steps a share of the envs too (None: the usable cores less one)"""
     device: str = "auto"
     """auto (CUDA when available), cpu or cuda"""
+    backend: str = "cpu"
+    """where the envs run: cpu (worker processes) or warp (every env in one MuJoCo Warp model on --device, beside the network; pip install "mjmaze[warp]")"""
     torch_threads: int | None = None
     """CPU threads for the network's update (None: PyTorch's default); on CPU the rollout uses one"""
     run_name: str | None = None
