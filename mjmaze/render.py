@@ -243,6 +243,25 @@ class EgoRenderer:
         mujoco.mjr_readPixels(self._buffer, None, self._viewport, self._context)
         return self._frame
 
+    def segmentation(self, data: mujoco.MjData) -> np.ndarray:
+        """``(H, W)`` int: the geom id drawn at each pixel of the current state, -1 for none (sky)."""
+        flags = (mujoco.mjtRndFlag.mjRND_SEGMENT, mujoco.mjtRndFlag.mjRND_IDCOLOR)
+        for flag in flags:
+            self._scene.flags[flag] = 1
+        try:
+            colours = self.render(data).astype(np.int64)
+        finally:
+            for flag in flags:
+                self._scene.flags[flag] = 0
+        # Each scene geom is drawn in the colour of its index + 1 (0 = nothing).
+        index = colours[..., 0] + colours[..., 1] * 256 + colours[..., 2] * 65536 - 1
+        geoms = np.array(
+            [g.objid if g.objtype == mujoco.mjtObj.mjOBJ_GEOM else -1 for g in self._scene.geoms[: self._scene.ngeom]]
+            + [-1],
+            dtype=np.int64,
+        )
+        return geoms[np.where(index >= 0, index, len(geoms) - 1)]
+
     def _light_from_above(self) -> None:
         self._scene.nlight = 1
         light = self._scene.lights[0]

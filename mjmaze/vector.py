@@ -49,6 +49,7 @@ from gymnasium.vector import AutoresetMode
 from gymnasium.vector.utils import batch_space
 
 from mjmaze import registry, suite
+from mjmaze.tasks import base
 
 SHARED_MEMORY_PREFIX = "mjmaze_"
 # How long a waiting process polls before it sleeps by default (see _poll_then_block).
@@ -119,6 +120,7 @@ class _EnvGroup:
             self._final_columns = {name: arrays["final_scalars"][name] for name in scalars.dtype.names}
         self._envs = []
         self._ended = [False] * len(slots)  # next-step mode: the env resets on its next step
+        self._state: dict[str, np.ndarray] | None = None  # the group's rule state (see reset)
         for slot, first in zip(slots, first_configs):
             env = suite.load(scenario, {**task_kwargs, "first_config": first})
             env.task.observation_buffer = self._obs[slot]
@@ -129,6 +131,14 @@ class _EnvGroup:
             if seeds is not None:
                 task.reseed(seeds[slot])
             self._restart(i, slot, env)
+        if self._state is None:
+            # From now on the group's envs keep their rule state in one set of
+            # arrays, a row each, and the rules run once per step for all of them.
+            tasks = [task for _, _, task, _ in self._envs]
+            self._state = {name: np.concatenate([t.state[name] for t in tasks]) for name in tasks[0].state}
+            for row, task in enumerate(tasks):
+                task.share_state(self._state, row)
+            self._paths = np.zeros((len(tasks), base.TICS_PER_STEP, 2))
 
     def _restart(self, i: int, slot: int, env) -> None:
         env.reset()  # renders the first frame into the env's slot
@@ -139,17 +149,28 @@ class _EnvGroup:
         _write_info(columns, slot, env.task.get_info(env.physics))
 
     def step(self) -> None:
-        columns, actions = self._columns, self._actions
-        for i, (slot, env, task, physics) in enumerate(self._envs):
+        columns, actions, paths = self._columns, self._actions, self._paths
+        envs = self._envs
+        for i, (slot, _, task, physics) in enumerate(envs):
+            if not self._ended[i]:
+                task.before_step(actions[slot], physics)
+                physics.step(base.TICS_PER_STEP)
+                paths[i] = physics.tic_xy
+        # The rules for every env of the group at once. An env about to restart
+        # (its episode ended on the last step) goes through them too, on its
+        # old state, which its restart then replaces.
+        rewards, terminated, truncated = envs[0][2].step_state(np, self._state, paths)
+        for i, (slot, env, task, physics) in enumerate(envs):
             if self._ended[i]:  # the step after an episode's end: its action is ignored
                 self._restart(i, slot, env)
                 continue
-            reward, terminated, truncated = task.advance(physics, actions[slot])
+            ended = bool(terminated[i])
+            task.finish_step(physics, float(rewards[i]), ended)
             task.get_observation(physics)
-            columns["reward"][slot] = reward
-            columns["terminated"][slot] = terminated
-            columns["truncated"][slot] = truncated
-            if terminated or truncated:
+            columns["reward"][slot] = rewards[i]
+            columns["terminated"][slot] = ended
+            columns["truncated"][slot] = truncated[i]
+            if ended or truncated[i]:
                 if not self._same_step:
                     self._ended[i] = True
                 else:

@@ -137,6 +137,8 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         frames for ``infos["final_obs"]`` (default). Every world is drawn at
         once, so this is a second render on every step where any env ends:
         pass False when the last frames are not needed (``mjmaze.train.a2c``).
+      render: draw observations (default). False steps physics and rules only
+        (observations stay black): for outcome statistics and benchmarks.
       render_segmentation: also render per-pixel geom ids (:meth:`segmentation`), for tests.
       **task_kwargs: the scenario's task arguments, as for the CPU envs. Env
         ``i`` cycles through the configurations from its own offset, as in
@@ -152,6 +154,7 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         device: str = "cuda",
         autoreset_mode: str | AutoresetMode = "next_step",
         keep_final_obs: bool = True,
+        render: bool = True,
         render_segmentation: bool = False,
         **task_kwargs: Any,
     ):
@@ -219,6 +222,7 @@ class MazeBatchEnv(gym.vector.VectorEnv):
                 enabled_geom_groups=[0, 1, 2],
             )
         self._segmentation = render_segmentation
+        self._rendering = bool(render)
         # Torch views of the Warp arrays (no copies): what the env writes and reads.
         self._qpos = wp.to_torch(self._data.qpos)
         self._qvel = wp.to_torch(self._data.qvel)
@@ -365,6 +369,8 @@ class MazeBatchEnv(gym.vector.VectorEnv):
 
     def _draw(self) -> None:
         """Renders every world's ego view into the observations."""
+        if not self._rendering:
+            return
         m, d, rc = self._model, self._data, self._render
         mjw.kinematics(m, d)  # positions lag a step behind mjw.step's integration
         mjw.camlight(m, d)

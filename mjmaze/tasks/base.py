@@ -196,8 +196,11 @@ class MazeTask(base.Task):
         self._bound_data = None
         self.config: configs.MazeConfig | None = None
         self._config_in_model: configs.MazeConfig | None = None
-        #: The episode's state as the rules see it: arrays with a batch of one (see :meth:`start`).
+        #: The episode's state as the rules see it (see :meth:`start`): arrays with
+        #: a batch of one, or a vector env's group of envs, this env in row :attr:`row`.
         self.state: dict[str, np.ndarray] | None = None
+        self.row = 0
+        self._shares_state = False
         self._reward = 0.0
         self._return = 0.0
         self._ended = False
@@ -251,20 +254,34 @@ class MazeTask(base.Task):
             self._config_in_model = config
         self.config = config
         self._reward, self._return, self._ended = 0.0, 0.0, False
-        self.state = self.start_state(np, self.config_arrays([config]), key)
-        physics.set_agent_pose(*self.state["pose"][0].tolist())
+        start = self.start_state(np, self.config_arrays([config]), key)
+        if self._shares_state:
+            for name, value in start.items():
+                self.state[name][self.row] = value[0]
+        else:
+            self.state = start
+        physics.set_agent_pose(*start["pose"][0].tolist())
         self._sync_objects(physics, everything=True)
+
+    def share_state(self, state: dict[str, np.ndarray], row: int) -> None:
+        """Keeps this env's state in row ``row`` of ``state``, the arrays of a group of envs.
+
+        A vector env applies the rules to all its envs in one call
+        (:meth:`step_state`; numpy's cost per call, not per env, dominates small
+        batches), then lets each env :meth:`finish_step`.
+        """
+        self.state, self.row, self._shares_state = state, int(row), True
 
     def _sync_objects(self, physics: MazePhysics, everything: bool = False) -> None:
         """Moves, shows, hides, colours the arena's objects as :attr:`state` says (what changed)."""
-        state, ids = self.state, self._object_ids
-        xy, shown = state["object_xy"][0], state["object_shown"][0]
+        state, ids, row = self.state, self._object_ids, self.row
+        xy, shown = state["object_xy"][row], state["object_shown"][row]
         if everything:
             self._xy_in_model = np.full_like(xy, np.nan)
             self._shown_in_model = ~shown
             self._collides_in_model = np.ones(len(ids), dtype=bool)
             if "object_rgba" in state:
-                for geom, rgba in zip(ids, state["object_rgba"][0]):
+                for geom, rgba in zip(ids, state["object_rgba"][row]):
                     physics.set_object_rgba(geom, rgba)
         moved = np.flatnonzero((xy != self._xy_in_model).any(axis=1))
         if len(moved):
@@ -275,7 +292,7 @@ class MazeTask(base.Task):
             physics.show_objects(ids[flipped], shown[flipped])
             self._shown_in_model = shown.copy()
         if "object_collides" in state:
-            collides = state["object_collides"][0]
+            collides = state["object_collides"][row]
             for k in np.flatnonzero(collides != self._collides_in_model):
                 physics.set_object_collisions(ids[k], bool(collides[k]))
             self._collides_in_model = collides.copy()
@@ -350,8 +367,12 @@ class MazeTask(base.Task):
 
     def after_step(self, physics: MazePhysics) -> None:
         reward, ended, _ = self.step_state(np, self.state, physics.tic_xy[None])
-        self._reward, self._ended = float(reward[0]), bool(ended[0])
-        self._return += self._reward
+        self.finish_step(physics, float(reward[0]), bool(ended[0]))
+
+    def finish_step(self, physics: MazePhysics, reward: float, ended: bool) -> None:
+        """Takes the rules' outcome for this env and moves its objects to match :attr:`state`."""
+        self._reward, self._ended = reward, ended
+        self._return += reward
         self._sync_objects(physics)
 
     def advance(self, physics: MazePhysics, action) -> tuple[float, bool, bool]:
@@ -373,6 +394,11 @@ class MazeTask(base.Task):
             return collections.OrderedDict(pixels=frame.copy())
         np.copyto(self.observation_buffer, frame)
         return collections.OrderedDict(pixels=self.observation_buffer)
+
+    def segmentation(self, physics: MazePhysics) -> np.ndarray:
+        """``(H, W)``: the geom id the agent sees at each pixel of its view, -1 for none (the sky)."""
+        self._bind(physics)
+        return self._renderer.segmentation(self._bound_data)
 
     def get_reward(self, physics: MazePhysics) -> float:
         return self._reward
@@ -403,14 +429,14 @@ class MazeTask(base.Task):
     @property
     def steps(self) -> int:
         """Agent steps taken in the current episode."""
-        return int(self.state["steps"][0]) if self.state is not None else 0
+        return int(self.state["steps"][self.row]) if self.state is not None else 0
 
     def metrics(self) -> dict:
         """The scenario's metric fields for ``info``, as Python scalars."""
-        state = self.state
+        state, row = self.state, self.row
         if state is None:  # before the first episode: what a new episode reports
-            state = self.start_state(np, self.config_arrays([self.configs[0]]), np.zeros(1, dtype=np.int64))
-        return {name: value[0].item() for name, value in self.episode_metrics(state).items()}
+            state, row = self.start_state(np, self.config_arrays([self.configs[0]]), np.zeros(1, dtype=np.int64)), 0
+        return {name: value[row].item() for name, value in self.episode_metrics(state).items()}
 
     def info_fields(self) -> dict[str, type]:
         """Names and Python types of the fields of :meth:`get_info`, known before any episode."""

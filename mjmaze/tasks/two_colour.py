@@ -102,9 +102,10 @@ class TwoColour(base.MazeTask):
     def config_arrays(self, configs_):
         arrays = super().config_arrays(configs_)
         # Each maze's wall boxes (x, y, half x, half y), padded with boxes far
-        # away so that every configuration has as many.
+        # away to one fixed count (every segment a run of its own at most), so
+        # that any set of configurations stacks.
         runs = [mjcf.wall_runs(config.h_walls, config.v_walls, config.cell_size) for config in configs_]
-        walls = np.tile(np.array([_FAR_AWAY, _FAR_AWAY, 0.0, 0.0]), (len(configs_), max(map(len, runs)), 1))
+        walls = np.tile(np.array([_FAR_AWAY, _FAR_AWAY, 0.0, 0.0]), (len(configs_), 2 * GRID_SIZE * (GRID_SIZE + 1), 1))
         for row, boxes in zip(walls, runs):
             row[: len(boxes)] = boxes
         arrays["walls"] = walls
@@ -231,12 +232,12 @@ class TwoColour(base.MazeTask):
     @property
     def item_xy(self) -> np.ndarray:
         """``(POOL_SIZE, 2)``: where each item of the pool is (a view: writes move them)."""
-        return self.state["object_xy"][0, 1:]
+        return self.state["object_xy"][self.row, 1:]
 
     @property
     def item_active(self) -> np.ndarray:
         """``(POOL_SIZE,)``: which items are on the floor (a view)."""
-        return self.state["object_shown"][0, 1:]
+        return self.state["object_shown"][self.row, 1:]
 
     @property
     def item_green(self) -> np.ndarray:
@@ -245,19 +246,19 @@ class TwoColour(base.MazeTask):
 
     @property
     def items_spawned(self) -> int:
-        return int(self.state["items_spawned"][0])
+        return int(self.state["items_spawned"][self.row])
 
     @property
     def totem_green(self) -> bool:
-        return bool(self.state["totem_green"][0])
+        return bool(self.state["totem_green"][self.row])
 
     @property
     def health(self) -> int:
-        return int(self.state["health"][0])
+        return int(self.state["health"][self.row])
 
     @health.setter
     def health(self, value: int) -> None:
-        self.state["health"][0] = value
+        self.state["health"][self.row] = value
 
 
 SCENARIO = registry.Scenario(

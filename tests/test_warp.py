@@ -1,0 +1,186 @@
+"""The MuJoCo Warp batch backend plays the CPU task: same rewards, flags, metrics, poses and frames.
+
+Run on Warp's CPU device (no GPU needed): a first run compiles Warp's kernels
+(about a minute, cached in ~/.cache/warp after).
+"""
+
+from __future__ import annotations
+
+import gymnasium
+import mujoco
+import numpy as np
+import pytest
+
+import mjmaze
+from mjmaze import registry, suite
+from mjmaze.tasks import base
+
+torch = pytest.importorskip("torch")
+pytest.importorskip("mujoco_warp")
+from mjmaze import warp as mjwarp  # noqa: E402
+
+# Each scenario at a small setting (compile and step time on CPU).
+SETTINGS = {
+    "labyrinth": {"size": 5},
+    "find_return": {"size": 5},
+    "k_item": {"num_items": 4},
+    "two_colour": {"complexity": 3},
+}
+SEED = 7
+# Frames of the same pose: Warp's ray tracer filters textures where GL samples
+# the nearest texel, and shades per pixel where GL shades per vertex.
+MAX_MEAN_COLOUR_DIFFERENCE = 32  # of 255, per channel, over a frame
+MIN_SEGMENTATION_AGREEMENT = 0.95
+
+
+def _cpu_twins(scenario: str, kwargs: dict, num_envs: int, batch: mjwarp.MazeBatchEnv):
+    """One dm_control env per world, seeded and offset as the batch env's worlds are."""
+    num_configs = len(batch.task.configs)
+    envs = []
+    for i in range(num_envs):
+        env = mjmaze.load(scenario, task_kwargs={**kwargs, "first_config": i * num_configs // num_envs % num_configs})
+        env.task.reseed(SEED + i)
+        env.reset()
+        envs.append(env)
+    return envs
+
+
+def _labels(model: mujoco.MjModel, geom_ids: np.ndarray) -> np.ndarray:
+    """Geom ids -> names, so that the two models' ids compare (-1: the sky)."""
+    names = {-1: ""}
+    for geom in np.unique(geom_ids):
+        if geom >= 0:
+            names[int(geom)] = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, int(geom))
+    return np.vectorize(names.__getitem__, otypes=[object])(geom_ids)
+
+
+@pytest.fixture(scope="module", params=list(SETTINGS))
+def scenario(request):
+    return request.param
+
+
+@pytest.mark.parametrize("num_envs", [4])
+def test_batch_env_plays_the_cpu_task_step_for_step(scenario, num_envs):
+    kwargs = SETTINGS[scenario]
+    batch = mjwarp.MazeBatchEnv(num_envs, scenario, device="cpu", render_segmentation=True, **kwargs)
+    obs, info = batch.reset(seed=SEED)
+    cpus = _cpu_twins(scenario, kwargs, num_envs, batch)
+    assert isinstance(obs, torch.Tensor) and obs.shape == (num_envs, 64, 112, 3) and obs.dtype == torch.uint8
+    actions = np.random.default_rng(0).integers(5, size=(100, num_envs))
+    pending = [False] * num_envs  # next-step autoreset: the CPU twin resets when the batch env does
+    frames_checked = 0
+    for step, action in enumerate(actions):
+        obs, reward, terminated, truncated, info = batch.step(torch.as_tensor(action))
+        for i, env in enumerate(cpus):
+            task, physics = env.task, env.physics
+            if pending[i]:
+                env.reset()
+                cpu = (0.0, False, False)
+                pending[i] = False
+            else:
+                cpu = task.advance(physics, int(action[i]))
+            assert (float(reward[i]), bool(terminated[i]), bool(truncated[i])) == pytest.approx(cpu, abs=1e-6), (step, i)
+            pending[i] = cpu[1] or cpu[2]
+            cpu_info = task.get_info(physics)
+            for name, value in cpu_info.items():
+                if name in ("x", "y"):
+                    assert abs(float(info[name][i]) - value) < 0.01, (step, i, name)  # 1 cm
+                elif name == "yaw":
+                    assert abs(np.remainder(float(info[name][i]) - value + np.pi, 2 * np.pi) - np.pi) < 1e-3
+                else:
+                    assert float(info[name][i]) == pytest.approx(float(value), abs=1e-6), (step, i, name)
+        if step % 20 == 0:  # frames of the same pose: what is where, and colours
+            seg = batch.segmentation().numpy()
+            for i, env in enumerate(cpus):
+                cpu_frame = env.task.get_observation(env.physics)["pixels"].astype(int)
+                cpu_seg = env.task.segmentation(env.physics)
+                agree = _labels(batch._host_model, seg[i]) == _labels(env.physics.model.ptr, cpu_seg)
+                assert agree.mean() >= MIN_SEGMENTATION_AGREEMENT, (step, i, agree.mean())
+                difference = np.abs(obs[i].numpy().astype(int) - cpu_frame).mean()
+                assert difference <= MAX_MEAN_COLOUR_DIFFERENCE, (step, i, difference)
+                frames_checked += 1
+    assert frames_checked == 5 * num_envs
+
+
+def test_same_step_autoreset_reports_the_final_info():
+    batch = mjwarp.MazeBatchEnv(2, "labyrinth", device="cpu", autoreset_mode="same_step", size=5)
+    batch.reset(seed=SEED)
+    # Put env 0's exit where its agent stands: the next step reaches it.
+    batch.state["object_xy"][0, 0] = batch._qpos[0, :2].double()
+    obs, reward, terminated, truncated, info = batch.step(torch.tensor([0, 0]))
+    assert terminated.tolist() == [True, False] and not truncated.any()
+    assert float(reward[0]) == pytest.approx(1.0 - 0.0004)
+    assert info["_final_info"].tolist() == [True, False]
+    assert bool(info["final_info"]["success"][0]) and int(info["final_info"]["step"][0]) == 1
+    assert int(info["step"][0]) == 0 and not bool(info["success"][0])  # already the next episode
+    assert info["final_obs"].shape == obs.shape
+
+
+def test_next_step_autoreset_ignores_the_action_after_the_end():
+    batch = mjwarp.MazeBatchEnv(2, "labyrinth", device="cpu", render=False, size=5)
+    batch.reset(seed=SEED)
+    batch.state["object_xy"][1, 0] = batch._qpos[1, :2].double()
+    _, reward, terminated, _, info = batch.step(torch.tensor([2, 2]))
+    assert terminated.tolist() == [False, True] and bool(info["success"][1])
+    _, reward, terminated, truncated, info = batch.step(torch.tensor([2, 2]))
+    assert float(reward[1]) == 0.0 and not terminated[1] and not truncated[1]
+    assert int(info["step"][1]) == 0 and int(info["step"][0]) == 2
+
+
+def test_reached_through_gymnasium_by_one_word():
+    envs = gymnasium.make_vec(
+        "mjmaze/KItem-v0", num_envs=3, vectorization_mode="vector_entry_point", backend="warp", device="cpu",
+        num_items=2, render=False,
+    )
+    assert isinstance(envs, mjwarp.MazeBatchEnv) and envs.single_action_space.n == 5
+    obs, info = envs.reset(seed=0)
+    assert set(suite.make_task("k_item", {"num_items": 2}).info_fields()) <= set(info)
+    envs.close()
+    with pytest.raises(ValueError, match="backend"):
+        gymnasium.make_vec("mjmaze/KItem-v0", num_envs=2, vectorization_mode="vector_entry_point", backend="tpu")
+
+
+def test_bad_arguments_say_what_to_do():
+    with pytest.raises(ValueError, match="autoreset_mode"):
+        mjwarp.MazeBatchEnv(2, "labyrinth", device="cpu", autoreset_mode="never")
+    with pytest.raises(ValueError, match="size"):
+        mjwarp.MazeBatchEnv(2, "labyrinth", device="cpu", size=6)
+
+
+# Random episodes from each side, the same seeds and actions: Warp's float32
+# may make a long wall-sliding run drift, so the outcomes are compared as
+# statistics (a 4-sigma two-sample test on the metric and the episode length).
+EPISODES = 1000
+
+
+def test_outcome_statistics_agree_over_random_episodes(scenario):
+    kwargs = SETTINGS[scenario]
+    metric = registry.get(scenario).metric
+    batch = mjwarp.MazeBatchEnv(EPISODES, scenario, device="cpu", render=False, **kwargs)
+    batch.reset(seed=SEED)
+    actions = np.random.default_rng(1).integers(5, size=(base.EPISODE_STEPS, EPISODES))
+    warp_metric, warp_length = np.full(EPISODES, np.nan), np.zeros(EPISODES)
+    for step in range(base.EPISODE_STEPS):
+        _, _, terminated, truncated, info = batch.step(torch.as_tensor(actions[step]))
+        ended = (terminated | truncated).numpy() & np.isnan(warp_metric)
+        warp_metric[ended] = info[metric].double().numpy()[ended]
+        warp_length[ended] = info["step"].numpy()[ended]
+        if not np.isnan(warp_metric).any():
+            break
+    env = mjmaze.load(scenario, task_kwargs=kwargs)
+    num_configs = len(env.task.configs)
+    cpu_metric, cpu_length = np.zeros(EPISODES), np.zeros(EPISODES)
+    for i in range(EPISODES):  # world i's first episode
+        env.task.first_config = i * num_configs // EPISODES % num_configs
+        env.task.reseed(SEED + i)
+        env.reset()
+        for step in range(base.EPISODE_STEPS):
+            _, terminated, truncated = env.task.advance(env.physics, int(actions[step, i]))
+            if terminated or truncated:
+                break
+        cpu_metric[i], cpu_length[i] = env.task.metrics()[metric], env.task.steps
+    for name, a, b in (("metric", warp_metric, cpu_metric), ("length", warp_length, cpu_length)):
+        error = np.sqrt((a.var() + b.var()) / EPISODES)
+        assert abs(a.mean() - b.mean()) <= 4 * error + 1e-9, (name, a.mean(), b.mean(), error)
+    # Most episodes are the very same episode on both sides.
+    assert (warp_length == cpu_length).mean() > 0.9
