@@ -135,10 +135,14 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--no-scaling", action="store_true")
     parser.add_argument("--baseline", default=None, help="a git revision whose vector env to measure beside (e.g. HEAD~3)")
+    parser.add_argument("--scenario", default="labyrinth",
+                        help="the scenario of (a) and (e) (labyrinth: 9x9; others at their default difficulty)")
     parser.add_argument("--vector-only", type=float, default=None, help=argparse.SUPPRESS)  # one (a), as JSON
     args = parser.parse_args()
     if args.vector_only is not None:
-        print(json.dumps(bench_vector(16, 9, args.vector_only)[0]))
+        timings: dict = {}
+        rate = bench_vector(16, *_setting(args.scenario), args.vector_only, timings, args.scenario)[0]
+        print(json.dumps({"rate": rate, "timings": timings}))
         return
     with baseline.checkout(args.baseline) if args.baseline else contextlib.nullcontext() as old:
         _compare(args, old)
@@ -146,11 +150,18 @@ def main() -> None:
         _scaling(args)
 
 
-def _baseline_vector(checkout, seconds: float) -> float:
-    """(a) from another revision: this script, run with that revision's mjmaze."""
-    result = subprocess.run([sys.executable, __file__, "--vector-only", str(seconds)], check=True, capture_output=True,
-                            text=True, env=baseline.environment(checkout))
-    return float(result.stdout.strip().splitlines()[-1])
+def _setting(scenario: str) -> tuple[int | None, ...]:
+    """``bench_vector``'s ``size`` for ``scenario`` (9 for Labyrinth, else its default difficulty)."""
+    return (9,) if scenario == "labyrinth" else (None,)
+
+
+def _vector_in_subprocess(checkout, seconds: float, scenario: str) -> tuple[float, dict]:
+    """(a) in a fresh process (this script with ``--vector-only``), with the mjmaze of ``checkout``
+    (None: this one): both sides start alike, whatever this process has loaded (ViZDoom, GL)."""
+    result = subprocess.run([sys.executable, __file__, "--vector-only", str(seconds), "--scenario", scenario],
+                            check=True, capture_output=True, text=True, env=baseline.environment(checkout))
+    answer = json.loads(result.stdout.strip().splitlines()[-1])
+    return answer["rate"], answer["timings"]
 
 
 def _compare(args, old) -> None:
@@ -171,16 +182,17 @@ def _compare(args, old) -> None:
         sides = list(rates)
         for side in sides if round_ % 2 == 0 else reversed(sides):
             if side == "mjmaze (16 envs)":
-                phases.append({})
-                rates[side].append(bench_vector(16, 9, args.seconds, phases[-1])[0])
+                rate, timings = _vector_in_subprocess(None, args.seconds, args.scenario)
+                rates[side].append(rate)
+                phases.append(timings)
             elif side.startswith("raw"):
                 rates[side].append(bench_processes(_raw_process, args.seconds))
             elif side.startswith("vizdoom"):
                 rates[side].append(bench_processes(_vizdoom_process, args.seconds))
             else:
-                rates[side].append(_baseline_vector(old, args.seconds))
+                rates[side].append(_vector_in_subprocess(old, args.seconds, args.scenario)[0])
     median = {name: statistics.median(values) for name, values in rates.items()}
-    print(f"Labyrinth 9x9 vs ViZDoom my_way_home, {CORES} cores, {args.rounds} rounds x {args.seconds:.0f} s (median, min-max)")
+    print(f"{args.scenario} vs ViZDoom my_way_home, {CORES} cores, {args.rounds} rounds x {args.seconds:.0f} s (median, min-max)")
     for name, values in rates.items():
         print(f"  {name:<20} {median[name]:8.0f} obs/s   ({min(values):.0f}-{max(values):.0f})")
     mjmaze_rate = median["mjmaze (16 envs)"]
