@@ -62,20 +62,31 @@ def uniform(xp, key: Array, *counters) -> Array:
     return xp.astype(mix(xp, key, *counters) >> 8, xp.float64) * (1.0 / (1 << 24))
 
 
-def first_tic(xp, points: Array, path: Array) -> Array:
-    """The first tic at which ``path`` comes within pick-up range of each point, -1 if none.
+def within_reach(xp, points: Array, path: Array) -> Array:
+    """``(B, n, tics)``: whether the agent is within pick-up range of each point after each tic.
 
     ``points`` ``(B, n, 2)``; ``path`` ``(B, tics, 2)``, the agent's ``(x, y)``
-    after each tic of the step (Doom tests pick-ups every tic). Returns ``(B, n)``.
+    after each tic of the step (Doom tests pick-ups every tic).
     """
     offsets = points[:, :, None, :] - path[:, None, :, :]  # (B, n, tics, 2)
-    inside = xp.sum(offsets * offsets, axis=-1) < PICKUP_RADIUS**2
+    return xp.sum(offsets * offsets, axis=-1) < PICKUP_RADIUS**2
+
+
+def reached(xp, points: Array, path: Array) -> Array:
+    """``(B, n)``: whether ``path`` comes within pick-up range of each of ``points`` at any tic."""
+    return xp.any(within_reach(xp, points, path), axis=-1)
+
+
+def first_tic(xp, points: Array, path: Array) -> Array:
+    """``(B, n)``: the first tic at which ``path`` comes within pick-up range of each point, -1 if none."""
+    inside = within_reach(xp, points, path)
+    # torch's argmax takes no booleans.
     return xp.where(xp.any(inside, axis=-1), xp.argmax(xp.astype(inside, xp.int8), axis=-1), -1)
 
 
 def touched(xp, point: Array, path: Array) -> Array:
-    """Whether ``path`` ``(B, tics, 2)`` comes within pick-up range of ``point`` ``(B, 2)``: ``(B,)``."""
-    return first_tic(xp, point[:, None, :], path)[:, 0] >= 0
+    """``(B,)``: whether ``path`` ``(B, tics, 2)`` comes within pick-up range of ``point`` ``(B, 2)``."""
+    return reached(xp, point[:, None, :], path)[:, 0]
 
 
 def seed_key(random_state) -> int:

@@ -82,7 +82,7 @@ class KItem(base.MazeTask):
     def rules(self, xp, state, path):
         # Items are in cells 1.25 m apart: one step (0.25 m) reaches at most
         # one of them, at any of its tics.
-        reached = (rules.first_tic(xp, state["object_xy"], path) >= 0) & state["object_shown"]
+        reached = rules.reached(xp, state["object_xy"], path) & state["object_shown"]
         is_next = rules.one_hot(xp, state["next"], self.num_items)
         correct = xp.any(reached & is_next, axis=1)
         wrong = ~correct & xp.any(reached, axis=1)
