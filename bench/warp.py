@@ -1,0 +1,123 @@
+"""MuJoCo Warp batch backend throughput: obs/s by number of worlds, with and without rendering.
+
+    python bench/warp.py [--device cuda] [--worlds 256 1024 4096 8192] [--scenarios all]
+                         [--seconds 5] [--train]
+
+For each scenario (Labyrinth 9x9 and every scenario at its default
+difficulty) and each world count, prints:
+  step+render  obs/s of MazeBatchEnv.step (random actions, autoreset), 64x112 RGB
+  step only    obs/s with render=False (physics and rules)
+  memory       device memory the env holds (GPU: CUDA's used memory after the
+               env is built and stepped, less before; CPU: the process's peak RSS)
+With --train, also the end-to-end training rate of `python -m mjmaze.train.a2c
+--backend warp` (rollout, network and update on the device) for the largest
+world count, read from its metrics.jsonl.
+
+Targets on one H100 (the issue): >= 200,000 obs/s step+render for Labyrinth 9x9,
+every scenario within 2x of it, training >= 50,000 obs/s. On Warp's CPU device
+(--device cpu) the figures only show that the bench runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import pathlib
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+
+# Python puts this script's folder first on sys.path, where this file (warp.py)
+# would stand in for the `warp` package that MuJoCo Warp imports.
+_HERE = pathlib.Path(__file__).resolve().parent
+sys.path[:] = [entry for entry in sys.path if pathlib.Path(entry or ".").resolve() != _HERE]
+
+import numpy as np  # noqa: E402
+import torch  # noqa: E402
+
+from mjmaze import registry  # noqa: E402
+from mjmaze.warp import MazeBatchEnv  # noqa: E402
+
+
+def _settings(names: list[str]) -> list[tuple[str, dict]]:
+    chosen = registry.names() if names == ["all"] else names
+    return [(name, {"size": 9} if name == "labyrinth" else {}) for name in chosen]
+
+
+def _device_memory_used(device: str) -> float:
+    """MB in use on ``device`` (the whole GPU's, as Warp allocates outside torch), or peak RSS on CPU."""
+    if device.startswith("cuda"):
+        torch.cuda.synchronize()
+        free, total = torch.cuda.mem_get_info(torch.device(device))
+        return (total - free) / 2**20
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def bench_env(scenario: str, kwargs: dict, worlds: int, device: str, render: bool, seconds: float) -> tuple[float, float]:
+    """``(obs/s, MB)`` of ``worlds`` envs stepping with random actions for ``seconds``."""
+    before = _device_memory_used(device)
+    envs = MazeBatchEnv(worlds, scenario, device=device, render=render, **kwargs)
+    envs.reset(seed=0)
+    generator = torch.Generator(device=device).manual_seed(0)
+
+    def actions():
+        return torch.randint(0, envs.single_action_space.n, (worlds,), device=device, generator=generator)
+
+    for _ in range(3):  # warm up (and compile on a first run)
+        envs.step(actions())
+    synchronize = torch.cuda.synchronize if device.startswith("cuda") else (lambda: None)
+    synchronize()
+    steps, start = 0, time.perf_counter()
+    while time.perf_counter() - start < seconds or steps < 3:
+        envs.step(actions())
+        steps += 1
+    synchronize()
+    rate = steps * worlds / (time.perf_counter() - start)
+    memory = _device_memory_used(device) - (before if device.startswith("cuda") else 0.0)
+    envs.close()
+    return rate, memory
+
+
+def bench_training(worlds: int, device: str, updates: int) -> float:
+    """Median obs/s of ``train.a2c --backend warp`` on Labyrinth 5x5 with ``worlds`` envs, 16 steps per update."""
+    with tempfile.TemporaryDirectory() as runs:
+        total = worlds * 16 * updates
+        subprocess.run(
+            [sys.executable, "-m", "mjmaze.train.a2c", "--scenario", "labyrinth", "--size", "5", "--backend", "warp",
+             "--device", device, "--num-envs", str(worlds), "--num-steps", "16", "--total-steps", str(total),
+             "--runs-dir", runs, "--run-name", "bench", "--checkpoint-every", str(10 * total), "--no-progress"],
+            check=True,
+        )
+        lines = (pathlib.Path(runs) / "bench" / "metrics.jsonl").read_text().splitlines()
+        rates = [json.loads(line)["sps"] for line in lines[1:]]  # the first update includes warm-up
+        return float(np.median(rates))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--device", default="cuda" if torch.cuda.is_available() else "cpu")
+    parser.add_argument("--worlds", type=int, nargs="+", default=[256, 1024, 4096, 8192])
+    parser.add_argument("--scenarios", nargs="+", default=["all"], help="scenario names, or all")
+    parser.add_argument("--seconds", type=float, default=5.0, help="measuring time per figure")
+    parser.add_argument("--train", action="store_true", help="also measure end-to-end training")
+    parser.add_argument("--train-updates", type=int, default=12)
+    args = parser.parse_args()
+    name = torch.cuda.get_device_name(args.device) if args.device.startswith("cuda") else "Warp CPU device"
+    print(f"MuJoCo Warp batch env on {args.device} ({name}); obs/s (median of one run per figure)")
+    print(f"{'scenario':<16}{'worlds':>8}{'step+render':>14}{'step only':>12}{'memory MB':>12}")
+    for scenario, kwargs in _settings(args.scenarios):
+        label = scenario + (f" {kwargs['size']}x{kwargs['size']}" if "size" in kwargs else "")
+        for worlds in args.worlds:
+            rendered, memory = bench_env(scenario, kwargs, worlds, args.device, True, args.seconds)
+            physics, _ = bench_env(scenario, kwargs, worlds, args.device, False, args.seconds)
+            print(f"{label:<16}{worlds:>8}{rendered:>14,.0f}{physics:>12,.0f}{memory:>12,.0f}", flush=True)
+    if args.train:
+        worlds = max(args.worlds)
+        rate = bench_training(worlds, args.device, args.train_updates)
+        print(f"training (train.a2c --backend warp, Labyrinth 5x5, {worlds} envs x 16 steps): {rate:,.0f} obs/s")
+
+
+if __name__ == "__main__":
+    main()
