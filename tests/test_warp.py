@@ -6,6 +6,7 @@ Run on Warp's CPU device (no GPU needed): a first run compiles Warp's kernels
 
 from __future__ import annotations
 
+import json
 import os
 
 import gymnasium
@@ -188,3 +189,18 @@ def test_outcome_statistics_agree_over_random_episodes(scenario):
         assert abs(a.mean() - b.mean()) <= 4 * error + 1e-9, (name, a.mean(), b.mean(), error)
     # Most episodes are the very same episode on both sides.
     assert (warp_length == cpu_length).mean() > 0.9
+
+
+def test_a2c_trains_on_the_warp_backend(tmp_path):
+    from mjmaze.train import a2c, checkpoint
+    from mjmaze.train import settings as run_settings
+
+    args = run_settings.Args(
+        scenario="labyrinth", size=5, backend="warp", device="cpu", num_envs=4, num_steps=8, total_steps=64,
+        runs_dir=str(tmp_path), run_name="warp", checkpoint_every=32, progress=False,
+    )
+    run = a2c.train(args)
+    lines = [json.loads(line) for line in (run / "metrics.jsonl").read_text().splitlines()]
+    assert [line["step"] for line in lines] == [32, 64]
+    assert all(np.isfinite(line["policy_loss"]) for line in lines)
+    assert [p.name for p in checkpoint.checkpoints(run / "checkpoints")][-1] == "step_000000000064.pt"
