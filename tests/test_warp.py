@@ -184,6 +184,8 @@ def test_outcome_statistics_agree_over_random_episodes(scenario):
             if terminated or truncated:
                 break
         cpu_metric[i], cpu_length[i] = env.task.metrics()[metric], env.task.steps
+    print(f"{scenario}, {EPISODES} episodes: {metric} Warp {warp_metric.mean():.4f} CPU {cpu_metric.mean():.4f}; "
+          f"length Warp {warp_length.mean():.1f} CPU {cpu_length.mean():.1f}; same length {(warp_length == cpu_length).mean():.3f}")
     for name, a, b in (("metric", warp_metric, cpu_metric), ("length", warp_length, cpu_length)):
         error = np.sqrt((a.var() + b.var()) / EPISODES)
         assert abs(a.mean() - b.mean()) <= 4 * error + 1e-9, (name, a.mean(), b.mean(), error)
