@@ -181,7 +181,8 @@ def _loop(args, make_envs, envs, agent, optimizer, device, run_dir, step, update
                     dones[t] = ended
                     episode_starts = ended
                     if "final_info" in infos:
-                        final = {k: v for k, v in infos["final_info"].items() if not k.startswith("_")}
+                        # One copy to the host per field (the Warp backend's are on the GPU), not one per value.
+                        final = {k: torch.as_tensor(v).cpu() for k, v in infos["final_info"].items() if not k.startswith("_")}
                         for i in torch.nonzero(ended).flatten().tolist():
                             finished.append({k: v[i].item() for k, v in final.items()})
             except WorkerError as error:
