@@ -84,7 +84,7 @@ def build_model(task: base.MazeTask) -> tuple[mujoco.MjModel, np.ndarray, np.nda
         name = geom.get("name", "")
         if name == "walls_visual":
             geom.set("mesh", f"{mjcf.WALL_MESH}_0")
-        elif name in ("floor",):
+        elif name == "floor":  # the one geom that stays in the world body
             continue
         worldbody.remove(geom)
         arena.append(geom)
@@ -113,10 +113,9 @@ def build_model(task: base.MazeTask) -> tuple[mujoco.MjModel, np.ndarray, np.nda
     visual = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "walls_visual")
     model.geom_pos[visual] = 0.0  # mesh vertices are in world coordinates
     model.geom_quat[visual] = (1.0, 0.0, 0.0, 0.0)
-    segments = mjcf.wall_segments(layout.grid_size, layout.cell_size)
+    # Boxes wall_0, wall_1, ... follow h_walls then v_walls (mjcf.wall_segments).
     present = np.array([np.concatenate([c.h_walls.ravel(), c.v_walls.ravel()]) for c in all_configs], dtype=bool)
     box_z = np.where(present, mjcf.WALL_HEIGHT / 2, _AWAY_Z).astype(np.float32)
-    assert box_z.shape[1] == len(segments)
     return model, mesh_of_config, box_z
 
 
