@@ -62,14 +62,16 @@ def scenario(request):
     return request.param
 
 
-@pytest.mark.parametrize("num_envs", [4])
-def test_batch_env_plays_the_cpu_task_step_for_step(scenario, num_envs):
-    kwargs = SETTINGS[scenario]
+def _plays_like_the_cpu(scenario: str, kwargs: dict, num_envs: int = 4, steps: int = 100, frames_every: int = 20,
+                        actions: np.ndarray | None = None) -> int:
+    """Steps a batch env and its CPU twins with the same actions; asserts equal outcomes. Returns frames compared."""
     batch = mjwarp.MazeBatchEnv(num_envs, scenario, device="cpu", render_segmentation=True, **kwargs)
     obs, info = batch.reset(seed=SEED)
     cpus = _cpu_twins(scenario, kwargs, num_envs, batch)
-    assert isinstance(obs, torch.Tensor) and obs.shape == (num_envs, 64, 112, 3) and obs.dtype == torch.uint8
-    actions = np.random.default_rng(0).integers(5, size=(100, num_envs))
+    assert isinstance(obs, torch.Tensor) and obs.dtype == torch.uint8
+    assert obs.shape == (num_envs, *batch.single_observation_space.shape)
+    if actions is None:
+        actions = np.random.default_rng(0).integers(batch.single_action_space.n, size=(steps, num_envs))
     pending = [False] * num_envs  # next-step autoreset: the CPU twin resets when the batch env does
     frames_checked = 0
     for step, action in enumerate(actions):
@@ -84,15 +86,14 @@ def test_batch_env_plays_the_cpu_task_step_for_step(scenario, num_envs):
                 cpu = task.advance(physics, int(action[i]))
             assert (float(reward[i]), bool(terminated[i]), bool(truncated[i])) == pytest.approx(cpu, abs=1e-6), (step, i)
             pending[i] = cpu[1] or cpu[2]
-            cpu_info = task.get_info(physics)
-            for name, value in cpu_info.items():
+            for name, value in task.get_info(physics).items():
                 if name in ("x", "y"):
                     assert abs(float(info[name][i]) - value) < 0.01, (step, i, name)  # 1 cm
                 elif name == "yaw":
                     assert abs(np.remainder(float(info[name][i]) - value + np.pi, 2 * np.pi) - np.pi) < 1e-3
                 else:
                     assert float(info[name][i]) == pytest.approx(float(value), abs=1e-6), (step, i, name)
-        if step % 20 == 0:  # frames of the same pose: what is where, and colours
+        if frames_every and step % frames_every == 0:  # frames of the same pose: what is where, and colours
             seg = batch.segmentation().numpy()
             for i, env in enumerate(cpus):
                 cpu_frame = env.task.get_observation(env.physics)["pixels"].astype(int)
@@ -102,7 +103,33 @@ def test_batch_env_plays_the_cpu_task_step_for_step(scenario, num_envs):
                 difference = np.abs(obs[i].numpy().astype(int) - cpu_frame).mean()
                 assert difference <= MAX_MEAN_COLOUR_DIFFERENCE, (step, i, difference)
                 frames_checked += 1
-    assert frames_checked == 5 * num_envs
+    return frames_checked
+
+
+def test_batch_env_plays_the_cpu_task_step_for_step(scenario):
+    assert _plays_like_the_cpu(scenario, SETTINGS[scenario]) == 5 * 4
+
+
+def test_task_arguments_carry_over():
+    _plays_like_the_cpu(
+        "find_return", {"size": 5, "action_set": "extended", "visual_style": "flat", "width": 48, "height": 32,
+                        "split": "test", "num_configs": 3, "config_sampling": "random"},
+        num_envs=3, steps=40, frames_every=10,
+    )
+
+
+def test_a_released_layout_that_spawns_inside_the_totem(tmp_path):
+    # The released Two-colour generator could put the spawn in the totem's cell:
+    # the totem blocks only once the agent has stepped clear (its collision twin in Warp).
+    config = mjmaze.load("two_colour", task_kwargs={"complexity": 1}).task.configs[0]
+    centre = [v * 128 for v in config.cell_centre(config.object_cells[0])]
+    half = config.size * config.cell_size / 2 * 128
+    exterior = [[-half, -half], [half, -half], [half, half], [-half, half]]
+    layout = {"walls": [], "exterior": exterior, "start": centre, "end": centre}  # an empty 5x5 maze
+    (tmp_path / "two_colour_000.json").write_text(json.dumps(layout))
+    forward_then_back = np.array([[2]] * 12 + [[0]] * 12 + [[2]] * 12)  # out, turn round, into the totem
+    _plays_like_the_cpu("two_colour", {"complexity": 1, "layouts": str(tmp_path)}, num_envs=1,
+                        actions=forward_then_back, frames_every=12)
 
 
 def test_same_step_autoreset_reports_the_final_info():
