@@ -3,6 +3,7 @@
 import csv
 import json
 import os
+import pathlib
 import signal
 import subprocess
 import sys
@@ -28,6 +29,17 @@ def test_the_generalisation_grid_varies_the_training_set():
     assert {r.scenario for r in runs} == {"labyrinth"}
     args = runs[0].args({"total_steps": 100}, "sweeps/g")
     assert args.task_kwargs()["num_configs"] == runs[0].num_configs
+
+
+def test_the_evidence_grid_runs_each_paper_curve_setting_with_its_own_length():
+    runs = sweep.grid("evidence")
+    assert [r.name for r in runs[:4]] == [
+        "labyrinth_size7_s0", "find_return_size5_s0", "k_item_num_items2_s0", "two_colour_complexity1_s0"]
+    assert [r.seed for r in runs] == [0] * 4 + [1] * 4
+    settings = {"total_steps": 5_000_000, "num_envs": 16, "num_steps": 128, "device": "cpu"}
+    lengths = {r.name: r.args(settings, pathlib.Path("sweeps")).total_steps for r in runs}
+    assert lengths["k_item_num_items2_s1"] == lengths["two_colour_complexity1_s0"] == 10_000_000
+    assert lengths["labyrinth_size7_s1"] == 5_000_000
 
 
 def test_a_custom_grid_needs_a_scenario_and_difficulties():

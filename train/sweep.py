@@ -3,6 +3,7 @@
     python -m mjmaze.train.sweep --grid small --total-steps 1000000     # Labyrinth 5 and 7 x 2 seeds
     python -m mjmaze.train.sweep --grid paper                           # Table 2: 4 scenarios x 4 difficulties x 3 seeds, 200M steps
     python -m mjmaze.train.sweep --grid generalisation                  # Labyrinth 9 with 16/64/256/1024 training mazes x 3 seeds
+    python -m mjmaze.train.sweep --grid evidence                        # learning curves beside the paper's: 4 settings x 2 seeds, 5-10M steps
     python -m mjmaze.train.sweep --grid custom --scenario k_item --difficulties 2 4 --seeds 0 1
     python -m mjmaze.train.sweep --grid paper --address auto --cpus-per-run 4 --gpus-per-run 0.25   # an existing cluster
     python -m mjmaze.train.report sweeps/paper                          # the table and curves
@@ -38,8 +39,14 @@ from .settings import Args
 GENERALISATION_CONFIGS = (16, 64, 256, 1024)
 # The generalisation study's maze size: the paper does not state it; Labyrinth's default.
 GENERALISATION_SIZE = 9
-GRIDS = ("paper", "generalisation", "small", "custom")
-DEFAULT_STEPS = {"paper": 200_000_000, "generalisation": 200_000_000, "small": 1_000_000, "custom": 10_000_000}
+# The settings whose curves the paper's released plots show rising early
+# (../paper/CURVES.md), each with the agent steps a 2-core machine can afford:
+# K-item and Two-colour rise only after ~5M observations.
+EVIDENCE = (("labyrinth", 7, 5_000_000), ("find_return", 5, 5_000_000), ("k_item", 2, 10_000_000),
+            ("two_colour", 1, 10_000_000))
+GRIDS = ("paper", "generalisation", "small", "evidence", "custom")
+DEFAULT_STEPS = {"paper": 200_000_000, "generalisation": 200_000_000, "small": 1_000_000, "evidence": 5_000_000,
+                 "custom": 10_000_000}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -50,6 +57,8 @@ class RunSpec:
     difficulty: int
     seed: int
     num_configs: int | None = None
+    #: This run's length in agent steps (None: the sweep's ``--total-steps``).
+    total_steps: int | None = None
 
     @property
     def name(self) -> str:
@@ -59,7 +68,7 @@ class RunSpec:
     def args(self, settings: dict, runs_dir: pathlib.Path) -> Args:
         """The training flags of this run: ``settings`` (shared by the sweep) plus its own."""
         return Args(**{
-            **settings, "scenario": self.scenario, registry.get(self.scenario).difficulty: self.difficulty, "seed": self.seed,
+            **settings, **({"total_steps": self.total_steps} if self.total_steps else {}), "scenario": self.scenario, registry.get(self.scenario).difficulty: self.difficulty, "seed": self.seed,
             "num_configs": self.num_configs, "runs_dir": str(runs_dir), "run_name": self.name, "progress": False,
         })
 
@@ -81,6 +90,9 @@ def grid(name: str, seeds: list[int] | None = None, scenario: str | None = None,
     if name == "small":
         seeds = seeds or [0, 1]
         return [RunSpec("labyrinth", d, seed) for d in (5, 7) for seed in seeds]
+    if name == "evidence":  # every setting's first seed before any second one
+        seeds = seeds or [0, 1]
+        return [RunSpec(scenario, d, seed, total_steps=steps) for seed in seeds for scenario, d, steps in EVIDENCE]
     if name == "custom":
         if scenario not in registry.names() or not difficulties:
             raise ValueError(f"--grid custom needs --scenario (one of {registry.names()}) and --difficulties")
@@ -121,10 +133,9 @@ def launch(specs: list[RunSpec], sweep_dir: pathlib.Path, settings: dict, *, add
     import ray
 
     sweep_dir = pathlib.Path(sweep_dir).resolve()  # Ray workers do not share the driver's working directory
-    total_steps = settings["total_steps"]
     results, todo = [], []
     for spec in specs:
-        done = finished(sweep_dir / spec.name, total_steps)
+        done = finished(sweep_dir / spec.name, spec.total_steps or settings["total_steps"])
         if done is not None:
             results.append({"name": spec.name, "status": "already finished", "eval": done})
             log(f"[sweep] {spec.name}: already finished (step {done['step']:,}), skipped")
@@ -194,6 +205,8 @@ def main(argv: list[str] | None = None) -> None:
         specs = grid(args.grid, args.seeds, args.scenario, args.difficulties, args.num_configs)
     except ValueError as error:
         raise SystemExit(f"error: {error}") from None
+    if args.total_steps:  # one length for every run, the grid's own lengths overridden
+        specs = [dataclasses.replace(spec, total_steps=None) for spec in specs]
     total_steps = args.total_steps or DEFAULT_STEPS[args.grid]
     settings = {
         "total_steps": total_steps, "num_envs": args.num_envs, "num_steps": args.num_steps, "device": args.device,
@@ -210,6 +223,7 @@ def main(argv: list[str] | None = None) -> None:
     sweep_dir = args.sweeps_dir / (args.name or args.grid)
     files.atomic_write_json(sweep_dir / "sweep.json", {
         "grid": args.grid, "runs": [s.name for s in specs], "settings": settings, "command": sys.argv,
+        "run_steps": {s.name: s.total_steps or total_steps for s in specs},
         "eval_configs": args.eval_configs,
     })
     try:
