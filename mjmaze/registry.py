@@ -45,6 +45,15 @@ class Scenario:
         with ``start`` and ``end``.
       imported_spawn_may_share_a_cell: whether an imported layout may put the
         spawn in an object's cell (the released Two-colour generator did).
+      paper_curves: difficulty -> ``((agent steps, value), ...)``: the paper's
+        training curve (A2C, mean of 3 seeds), read by eye off the plots released
+        with its implementation (edbeeching/3D_Control_RL_Scenario_Benchmarks,
+        ``results/``; their x axis counts frames, 4 per agent step), see
+        :func:`paper_curve`.
+      paper_curve_field: the ``info`` field those curves plot (``""``: ``metric``).
+      paper_curve_scale: factor from that field's mean to the curves' units
+        (None: ``metric_scale``).
+      paper_curve_units: the curves' units (``""``: ``metric_units``).
     """
 
     name: str
@@ -63,6 +72,35 @@ class Scenario:
     paper_results: Mapping[int, tuple[float, float, float, float]] = dataclasses.field(default_factory=dict)
     item_codes: tuple[str, ...] | None = None
     imported_spawn_may_share_a_cell: bool = False
+    paper_curves: Mapping[int, tuple[tuple[int, float], ...]] = dataclasses.field(default_factory=dict)
+    paper_curve_field: str = ""
+    paper_curve_scale: float | None = None
+    paper_curve_units: str = ""
+
+    @property
+    def curve_field(self) -> str:
+        """The ``info`` field the paper's curves plot."""
+        return self.paper_curve_field or self.metric
+
+    @property
+    def curve_scale(self) -> float:
+        return self.metric_scale if self.paper_curve_scale is None else self.paper_curve_scale
+
+    @property
+    def curve_units(self) -> str:
+        return self.paper_curve_units or self.metric_units
+
+
+#: Agent steps at which the paper's curves were read (its plots' 10M, 20M, 40M,
+#: 100M, 200M and 800M frames).
+PAPER_CURVE_STEPS = (2_500_000, 5_000_000, 10_000_000, 25_000_000, 50_000_000, 200_000_000)
+
+
+def paper_curve(values: tuple[float, ...]) -> tuple[tuple[int, float], ...]:
+    """``((agent steps, value), ...)`` from values read at :data:`PAPER_CURVE_STEPS`."""
+    if len(values) != len(PAPER_CURVE_STEPS):
+        raise ValueError(f"a paper curve has {len(PAPER_CURVE_STEPS)} values, got {len(values)}")
+    return tuple(zip(PAPER_CURVE_STEPS, values))
 
 
 _SCENARIOS: dict[str, Scenario] = {}

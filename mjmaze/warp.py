@@ -235,7 +235,6 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         self._seed_keys = torch.zeros(n, dtype=torch.int64, device=dev)
         self._episodes = torch.zeros(n, dtype=torch.int64, device=dev)
         self._config_index = torch.zeros(n, dtype=torch.int64, device=dev)
-        self._returns = torch.zeros(n, dtype=torch.float64, device=dev)
         self._ended = torch.zeros(n, dtype=torch.bool, device=dev)
         self._path = torch.zeros((n, base.TICS_PER_STEP, 2), dtype=torch.float64, device=dev)
         self._obs = torch.zeros((n, height, width, 3), dtype=torch.uint8, device=dev)
@@ -274,7 +273,6 @@ class MazeBatchEnv(gym.vector.VectorEnv):
             self._advance_physics()
             reward, terminated, truncated = task.step_state(xp, self.state, self._path)
             self._place_objects(self.state)
-            self._returns += reward
             if self.autoreset_mode == AutoresetMode.NEXT_STEP:
                 # Envs that ended on the previous step start anew; this step's action is ignored.
                 reward = torch.where(ended_before, 0.0, reward)
@@ -337,7 +335,6 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         else:
             for name, value in start.items():
                 self.state[name][envs] = value
-        self._returns[envs] = 0.0
         pose = start["pose"]
         self._qpos[envs, 0:3] = pose.float()
         self._qvel[envs] = 0.0
@@ -393,7 +390,7 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         fields = dict(task.episode_metrics(state))
         fields.update(
             x=qpos[:, 0], y=qpos[:, 1], yaw=qpos[:, 2] - math.tau * torch.round(qpos[:, 2] / math.tau),
-            step=state["steps"], episode_return=self._returns.clone(), config_index=self._config_index.clone(),
+            step=state["steps"], episode_return=state["episode_return"], config_index=self._config_index.clone(),
         )
         if mask is None:
             mask = torch.ones(self.num_envs, dtype=torch.bool, device=self.device)

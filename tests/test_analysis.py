@@ -107,6 +107,9 @@ def test_learning_curves_average_seeds_with_train_and_test_evaluations(tmp_path,
     assert all(0 < v <= 2100 for v in two_colour["training"]["mean"])
     assert two_colour["evaluations"]["step"] == [160, 320] and two_colour["evaluations"]["seeds"] == [2, 2]
     assert all(0 < v <= 2100 for v in two_colour["evaluations"]["test_mean"])
+    # The paper's own curve at complexity 3 is drawn beside ours (Labyrinth 5 is not in the paper).
+    assert two_colour["paper"]["step"][:2] == [2_500_000, 5_000_000] and two_colour["paper"]["value"][0] == 430
+    assert groups[1]["paper"]["step"] == []
     for run in runs:
         assert sorted(p.name for p in (run / "evals").iterdir()) == ["step_000000000160.json", "step_000000000320.json"]
     picture(out)

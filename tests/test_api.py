@@ -71,7 +71,7 @@ def test_check_env_passes_without_warnings(env_id, kwargs):
 METRIC_FIELDS = {
     "labyrinth": {"success"},
     "find_return": {"success", "target_found"},
-    "k_item": {"items_in_order", "item_score"},
+    "k_item": {"items_in_order", "item_score", "normalised_return"},
     "two_colour": {"duration", "health", "totem_green"},
 }
 

@@ -80,7 +80,9 @@ def test_right_then_wrong_item_ends_the_episode():
     timestep = touch(env, items[2])  # kind 3 before kind 2
     assert timestep.last() and timestep.discount == 0.0
     assert timestep.reward == pytest.approx(STEP - 0.25)
-    assert env.task.metrics() == {"items_in_order": 1, "item_score": 0.25}
+    # The paper's curve unit: the return (+0.5 - 0.25 and two steps' cost) over its most, 4 x 0.5.
+    assert env.task.metrics() == pytest.approx(
+        {"items_in_order": 1, "item_score": 0.25, "normalised_return": (0.5 - 0.25 + 2 * STEP) / 2.0})
 
 
 @pytest.mark.parametrize("num_items", k_item.PAPER_NUM_ITEMS)

@@ -4,8 +4,11 @@
     python -m mjmaze.train.curves runs/lab5_s* --evaluate      # also greedy train/test at every kept checkpoint
 
 Runs with the same scenario and difficulty (config.json) are seeds of one curve
-and share a panel. Solid: the training episodes' metric from ``metrics.jsonl``
-(sampled actions, training mazes), averaged in ``--bins`` step bins. With
+and share a panel. Solid: the training episodes' value from ``metrics.jsonl``
+(sampled actions, training mazes) in the units of the paper's training curves
+(the metric; for K-item the return over its most), averaged in ``--bins`` step
+bins. Black squares: the paper's own curve at that difficulty, read off its
+released plots (``mjmaze.registry.Scenario.paper_curves``). With
 ``--evaluate`` (or where a run already has them), greedy evaluations of each
 kept checkpoint on the training and test configurations (``mjmaze.train.evaluate``,
 cached in ``<run>/evals/step_N.json``) are drawn as markers. Writes the PNG and
@@ -21,7 +24,7 @@ import pathlib
 import numpy as np
 from matplotlib.figure import Figure
 
-from mjmaze import files, suite
+from mjmaze import files, registry
 
 from . import checkpoint, evaluate
 from .analysis import save_figure
@@ -35,7 +38,7 @@ def read_run(run_dir: pathlib.Path) -> dict:
     if not config_file.exists():
         raise FileNotFoundError(f"{run_dir} is not a training run (no config.json)")
     config = json.loads(config_file.read_text())
-    field = suite.paper_metric(config["scenario"])[0]
+    field = registry.get(config["scenario"]).curve_field
     steps, values = [], []
     metrics_file = run_dir / "metrics.jsonl"
     if metrics_file.exists():
@@ -123,9 +126,13 @@ def curves(run_dirs: list[pathlib.Path], bins: int = BINS) -> list[dict]:
     result = []
     for runs in groups.values():
         config = runs[0]["config"]
+        declared = registry.get(config["scenario"])
+        paper = declared.paper_curves.get(config.get(declared.difficulty), ()) if not config.get("num_configs") else ()
         result.append({
-            "label": label(config), "scenario": config["scenario"], "units": suite.paper_metric(config["scenario"])[2],
+            "label": label(config), "scenario": config["scenario"], "units": declared.curve_units,
+            "eval_units": declared.metric_units,
             "runs": [r["dir"] for r in runs], "training": binned(runs, bins), "evaluations": evaluations(runs),
+            "paper": {"step": [s for s, _ in paper], "value": [v for _, v in paper]},
         })
     return result
 
@@ -149,14 +156,23 @@ def figure(groups: list[dict], title: str = "") -> Figure:
             name = None  # one legend entry per group
         ev = group["evaluations"]
         if ev["step"]:
+            if group["eval_units"] != group["units"]:
+                name = f"{name or group['label']}: o x greedy in {group['eval_units']}"
             ax.errorbar(ev["step"], ev["train_mean"], yerr=ev["train_std"], color=colour, marker="o", linestyle="none",
                         markersize=4, capsize=2, label=name)
             ax.errorbar(ev["step"], ev["test_mean"], yerr=ev["test_std"], color=colour, marker="x", linestyle="--",
                         markersize=5, capsize=2, linewidth=0.8)
+        paper = group.get("paper", {"step": []})
+        if paper["step"]:
+            # Only the paper's points within (a little beyond) the steps ours reach: its 200M would squash ours.
+            reach = max([*group["training"]["step"], *ev["step"], 0]) * 2.2
+            shown = [(x, y) for x, y in zip(paper["step"], paper["value"]) if x <= max(reach, paper["step"][0])]
+            ax.plot(*zip(*shown), color="black", marker="s", linestyle=":", markersize=4,
+                    label=f"paper, {group['label']} (read off its plots)")
     for ax, scenario in zip(axes, scenarios):
         ax.set_title(scenario, fontsize=10)
-        ax.set_xlabel("agent steps")
-        ax.set_ylabel(suite.paper_metric(scenario)[2])
+        ax.set_xlabel("agent steps (observations)")
+        ax.set_ylabel(registry.get(scenario).curve_units)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="best")
     if title:

@@ -202,7 +202,6 @@ class MazeTask(base.Task):
         self.row = 0
         self._shares_state = False
         self._reward = 0.0
-        self._return = 0.0
         self._ended = False
 
     # -- configuration and episode start ---------------------------------
@@ -253,7 +252,7 @@ class MazeTask(base.Task):
             self._renderer.upload_mesh(self._walls.mesh_id)
             self._config_in_model = config
         self.config = config
-        self._reward, self._return, self._ended = 0.0, 0.0, False
+        self._reward, self._ended = 0.0, False
         start = self.start_state(np, self.config_arrays([config]), key)
         if self._shares_state:
             for name, value in start.items():
@@ -348,12 +347,14 @@ class MazeTask(base.Task):
         state = self.start(xp, config, keys)
         state["key"] = keys
         state["steps"] = xp.zeros(keys.shape, dtype=xp.int64, device=rules.device(keys))
+        state["episode_return"] = xp.zeros(keys.shape, dtype=xp.float64, device=rules.device(keys))
         return state
 
     def step_state(self, xp, state: dict, path) -> tuple:
         """One agent step of the rules for a batch: ``(reward, terminated, truncated)``, each ``(B,)``."""
         state["steps"] = state["steps"] + 1
         reward, terminated = self.rules(xp, state, path)
+        state["episode_return"] = state["episode_return"] + reward
         return reward, terminated, ~terminated & (state["steps"] >= EPISODE_STEPS)
 
     # -- the per-step path ------------------------------------------------
@@ -372,7 +373,6 @@ class MazeTask(base.Task):
     def finish_step(self, physics: MazePhysics, reward: float, ended: bool) -> None:
         """Takes the rules' outcome for this env and moves its objects to match :attr:`state`."""
         self._reward, self._ended = reward, ended
-        self._return += reward
         self._sync_objects(physics)
 
     def advance(self, physics: MazePhysics, action) -> tuple[float, bool, bool]:
@@ -449,7 +449,8 @@ class MazeTask(base.Task):
         x, y, yaw = physics.agent_pose()
         info = self.metrics()
         info.update(
-            x=x, y=y, yaw=yaw, step=self.steps, episode_return=self._return,
+            x=x, y=y, yaw=yaw, step=self.steps,
+            episode_return=float(self.state["episode_return"][self.row]) if self.state is not None else 0.0,
             config_index=self.config.index if self.config else -1,
         )
         return info

@@ -14,8 +14,9 @@ Arguments
     ``num_items`` K (paper: 2, 4, 6, 8; any of 1..8 works), ``size`` (grid, default
     5; K + 1 cells are needed) and the common task arguments.
 Metric
-    ``item_score`` = items collected in order / K; also ``items_in_order`` and
-    ``episode_return`` (the raw return).
+    ``item_score`` = items collected in order / K; also ``items_in_order``,
+    ``episode_return`` (the raw return) and ``normalised_return`` (the return
+    over its most, K x 0.5: the unit of the paper's K-item training curves).
 
 The collection order is item kind 1, then 2, ... by the released files' colour
 codes: green, red, blue, cyan, magenta, yellow, then two greys, which also
@@ -96,7 +97,12 @@ class KItem(base.MazeTask):
         return reward, wrong | (state["next"] == self.num_items)
 
     def episode_metrics(self, state):
-        return {"items_in_order": state["next"], "item_score": state["next"] / self.num_items}
+        return {
+            "items_in_order": state["next"],
+            "item_score": state["next"] / self.num_items,
+            # The unit of the paper's K-item curves: the return over its most (K x 0.5).
+            "normalised_return": state["episode_return"] / (NEXT_ITEM_REWARD * self.num_items),
+        }
 
 
 SCENARIO = registry.Scenario(
@@ -118,4 +124,12 @@ SCENARIO = registry.Scenario(
         6: (0.577, 0.024, 0.522, 0.023), 8: (0.084, 0.071, 0.083, 0.070),
     },
     item_codes=tuple(code for code, _ in KINDS),
+    # The released plots show the return over its most (K x 0.5), not items in order / K.
+    paper_curves={
+        2: registry.paper_curve((-0.2, -0.2, 0.05, 0.3, 0.78, 0.92)),
+        4: registry.paper_curve((-0.1, -0.1, -0.05, 0.05, 0.1, 0.86)),
+    },
+    paper_curve_field="normalised_return",
+    paper_curve_scale=1.0,
+    paper_curve_units="return / (K x 0.5)",
 )

@@ -279,4 +279,10 @@ SCENARIO = registry.Scenario(
     # The released generator could spawn the agent in the totem's cell; such
     # an imported layout plays as released (see TwoColour).
     imported_spawn_may_share_a_cell=True,
+    # Tics survived in training episodes, read off the released plots (see registry.Scenario.paper_curves).
+    paper_curves={
+        1: registry.paper_curve((430, 530, 700, 850, 1100, 1920)),
+        3: registry.paper_curve((430, 530, 720, 1000, 1100, 1750)),
+        7: registry.paper_curve((410, 470, 650, 780, 900, 1100)),
+    },
 )
