@@ -161,6 +161,19 @@ def test_evaluation_plays_every_configuration_twice(tmp_path, monkeypatch):
     assert saved["test"]["episodes"] == 16 and saved["units"] == "success %"
 
 
+def test_a_random_policy_is_evaluated_the_same_way(tmp_path, monkeypatch):
+    monkeypatch.setattr(evaluate, "EVAL_CONFIGS", 4)
+    out = tmp_path / "random_k2.json"
+    evaluate.main(["random", "--scenario", "k_item", "--num-items", "2", "--num-envs", "4", "--out", str(out)])
+    result = json.loads(out.read_text())
+    assert result["run"] == "random" and result["task_kwargs"] == {"num_items": 2}
+    for split in ("train", "test"):
+        assert result[split]["configs"] == sorted(list(range(4)) * 2)
+        assert 0.0 <= result[split]["value"] <= 1.0  # items in order / K
+        # The paper's K-item curves are in return / (K x 0.5): the mean return over 1.0.
+        assert result[split]["curve_value"] == pytest.approx(result[split]["mean_return"])
+
+
 def start_training(tmp_path, name: str, *flags: str):
     """``python -m mjmaze.train.a2c`` on Labyrinth 5x5 in a subprocess, once it has logged two updates."""
     import subprocess
