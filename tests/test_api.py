@@ -134,3 +134,17 @@ def test_random_rollout_prints_metrics_and_writes_a_frame_strip(tmp_path, capsys
     assert "obs/s" in printed and "two_colour" in printed
     strip = iio.imread(out)
     assert strip.shape == (64, 4 * 112, 3) and strip.std() > 0
+
+
+def test_the_cpu_envs_import_neither_warp_nor_torch():
+    # The rules are array functions for numpy and torch alike; only the Warp backend brings torch and Warp in.
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, gymnasium, mjmaze\n"
+        "env = gymnasium.make('mjmaze/TwoColour-v0'); env.reset(seed=0); env.step(0)\n"
+        "print(sorted(m for m in ('warp', 'mujoco_warp', 'torch') if m in sys.modules))\n"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert result.stdout.strip().splitlines()[-1] == "[]"
