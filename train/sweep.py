@@ -44,6 +44,8 @@ GENERALISATION_SIZE = 9
 # K-item and Two-colour rise only after ~5M observations.
 EVIDENCE = (("labyrinth", 7, 5_000_000), ("find_return", 5, 5_000_000), ("k_item", 2, 10_000_000),
             ("two_colour", 1, 10_000_000))
+# Enough to keep every checkpoint of the longest run (a greedy evaluation of each draws the curve).
+KEEP_EVERY_CHECKPOINT = 1000
 GRIDS = ("paper", "generalisation", "small", "evidence", "custom")
 DEFAULT_STEPS = {"paper": 200_000_000, "generalisation": 200_000_000, "small": 1_000_000, "evidence": 5_000_000,
                  "custom": 10_000_000}
@@ -191,6 +193,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--num-envs", type=int, default=Args.num_envs)
     parser.add_argument("--num-steps", type=int, default=Args.num_steps)
     parser.add_argument("--checkpoint-every", type=int, default=None, help="default: total steps / 20")
+    parser.add_argument("--keep-checkpoints", type=int, default=None,
+                        help="checkpoints kept per run (default: every one for --grid evidence, whose curves "
+                             "evaluate each, else 3)")
     parser.add_argument("--device", default="auto", help="auto (CUDA where Ray gives the task a GPU), cpu, cuda")
     parser.add_argument("--address", default=None, help="an existing Ray cluster ('auto' or host:port)")
     parser.add_argument("--num-cpus", type=int, default=None, help="local Ray: CPUs to use (default: all)")
@@ -211,6 +216,7 @@ def main(argv: list[str] | None = None) -> None:
     settings = {
         "total_steps": total_steps, "num_envs": args.num_envs, "num_steps": args.num_steps, "device": args.device,
         "checkpoint_every": args.checkpoint_every or max(args.num_envs * args.num_steps, total_steps // 20),
+        "keep_checkpoints": args.keep_checkpoints or (KEEP_EVERY_CHECKPOINT if args.grid == "evidence" else Args.keep_checkpoints),
         # The training process steps a share of the envs itself: one worker fewer than the run's CPUs.
         "num_workers": args.cpus_per_run - 1, "torch_threads": args.cpus_per_run,
     }
