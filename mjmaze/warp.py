@@ -257,7 +257,7 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         self._episodes.zero_()
         with self._warp_stream():
             self._start_episodes(torch.arange(n, device=self.device))
-            self._draw()
+            self._show_state()
         self._ended.zero_()
         return self._obs.clone(), self._infos()
 
@@ -272,7 +272,6 @@ class MazeBatchEnv(gym.vector.VectorEnv):
             self._qvel[:, 0], self._qvel[:, 1], self._qvel[:, 2] = vx, vy, wz
             self._advance_physics()
             reward, terminated, truncated = task.step_state(xp, self.state, self._path)
-            self._place_objects(self.state)
             if self.autoreset_mode == AutoresetMode.NEXT_STEP:
                 # Envs that ended on the previous step start anew; this step's action is ignored.
                 reward = torch.where(ended_before, 0.0, reward)
@@ -285,7 +284,7 @@ class MazeBatchEnv(gym.vector.VectorEnv):
                 final = self._final_infos(terminated | truncated) if len(restart) else {}
             if len(restart):
                 self._start_episodes(restart)
-            self._draw()
+            self._show_state()
         self._ended = terminated | truncated
         infos = self._infos()
         infos.update(final)
@@ -295,7 +294,7 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         """``final_info`` (and ``final_obs``) of the envs that just ended, before they are reset."""
         final = {"final_info": self._infos(mask=ended), "_final_info": ended}
         if self._keep_final_obs:
-            self._draw()
+            self._show_state()
             final["final_obs"] = self._obs.clone()
             final["_final_obs"] = ended
         return final
@@ -346,7 +345,6 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         self._geom_dataid[envs, self._wall_visual] = self._mesh_of_config[config_index].int()
         if "object_rgba" in start:
             self._geom_rgba[rows, self._object_ids[None, :]] = start["object_rgba"].float()
-        self._place_objects(self.state)
 
     def _place_objects(self, state: dict) -> None:
         """Moves every world's objects where ``state`` says; hidden or non-blocking ones below the floor."""
@@ -363,8 +361,9 @@ class MazeBatchEnv(gym.vector.VectorEnv):
             pos[:, self._collision_ids, 0:2] = xy[:, self._colliding]
             pos[:, self._collision_ids, 2] = torch.where(blocks, self._object_z[self._colliding], _AWAY_Z)
 
-    def _draw(self) -> None:
-        """Renders every world's ego view into the observations."""
+    def _show_state(self) -> None:
+        """Moves every world's objects where the rule state says (once per step), then renders the observations."""
+        self._place_objects(self.state)
         if not self._rendering:
             return
         m, d, rc = self._model, self._data, self._render
