@@ -12,7 +12,7 @@ It plays the same task as the CPU envs: the same configurations (splits,
 (:meth:`mjmaze.tasks.base.MazeTask.start` and
 :meth:`~mjmaze.tasks.base.MazeTask.rules`, called here on torch tensors with a
 batch of all envs), the same agent motion
-(:func:`mjmaze.tasks.base.agent_velocity`) and the same per-tic speculative
+(:func:`mjmaze.tasks.base.tic_motion`) and the same per-tic speculative
 contacts; env ``i`` seeded with ``s`` plays the same episodes as a CPU env
 seeded with ``s``. Warp computes in float32, so long runs drift apart by
 rounding (tests/test_warp.py checks the first 100 steps and outcome statistics).
@@ -237,6 +237,7 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         self._config_index = torch.zeros(n, dtype=torch.int64, device=dev)
         self._ended = torch.zeros(n, dtype=torch.bool, device=dev)
         self._path = torch.zeros((n, base.TICS_PER_STEP, 2), dtype=torch.float64, device=dev)
+        self._turn_held = torch.zeros(n, dtype=torch.float64, device=dev)  # tics a turn key has been held
         self._obs = torch.zeros((n, height, width, 3), dtype=torch.uint8, device=dev)
         self.state: dict[str, torch.Tensor] | None = None
         self._info_fields = task.info_fields()
@@ -267,10 +268,7 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         actions = torch.as_tensor(actions, device=self.device).long()
         ended_before = self._ended.clone()
         with self._warp_stream():
-            forward, turn = self._actions[actions, 0], self._actions[actions, 1]
-            vx, vy, wz = base.agent_velocity(xp, forward, turn, self._qpos[:, 2].double(), self._timestep)
-            self._qvel[:, 0], self._qvel[:, 1], self._qvel[:, 2] = vx, vy, wz
-            self._advance_physics()
+            self._advance_physics(self._actions[actions, 0], self._actions[actions, 1])
             reward, terminated, truncated = task.step_state(xp, self.state, self._path)
             if self.autoreset_mode == AutoresetMode.NEXT_STEP:
                 # Envs that ended on the previous step start anew; this step's action is ignored.
@@ -310,14 +308,19 @@ class MazeBatchEnv(gym.vector.VectorEnv):
             return wp.ScopedDevice(self._wp_device)
         return wp.ScopedStream(self._stream)
 
-    def _advance_physics(self) -> None:
-        """The step's tics with speculative contacts, as :meth:`mjmaze.tasks.base.MazePhysics.step`."""
+    def _advance_physics(self, forward: torch.Tensor, turn: torch.Tensor) -> None:
+        """The step's tics with Doom's motion and speculative contacts, as :meth:`mjmaze.tasks.base.MazePhysics.step`."""
         qpos, qvel, dt = self._qpos, self._qvel, self._timestep
         for tic in range(base.TICS_PER_STEP):
+            vx, vy, yaw_rate, self._turn_held = base.tic_motion(
+                self.xp, qvel[:, 0].double(), qvel[:, 1].double(), qpos[:, 2].double(), forward, turn, self._turn_held, dt
+            )
+            qvel[:, 0], qvel[:, 1], qvel[:, 2] = vx, vy, yaw_rate
             ahead = qvel[:, :2] * dt
             qpos[:, :2] += ahead
             mjw.step(self._model, self._data)
             qpos[:, :2] -= ahead
+            qvel[:, :2] *= base.FRICTION
             self._path[:, tic] = qpos[:, :2]
 
     def _start_episodes(self, envs: torch.Tensor) -> None:
@@ -337,6 +340,7 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         pose = start["pose"]
         self._qpos[envs, 0:3] = pose.float()
         self._qvel[envs] = 0.0
+        self._turn_held[envs] = 0
         self._warmstart[envs] = 0.0
         # The maze: its wall boxes, its wall mesh.
         geom_pos = self._geom_pos

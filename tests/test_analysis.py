@@ -84,9 +84,11 @@ def test_hidden_state_analysis_of_a_random_policy_on_two_colour(tmp_path):
 def test_tsne_keeps_at_most_the_asked_number_of_states(tmp_path):
     out = tmp_path / "analysis"
     run = tiny_run(tmp_path, "tiny")
-    analysis.main([str(run), "--episodes", "2", "--max-steps", "50", "--tsne-states", "60", "--out", str(out)])
+    analysis.main([str(run), "--episodes", "3", "--max-steps", "50", "--tsne-states", "60", "--out", str(out)])
     summary = json.loads((out / "summary.json").read_text())
-    assert summary["states"] == 100 and summary["tsne_points"] == 60
+    # Episodes may end early at the exit; three of up to 50 steps still hold more than 60 states.
+    assert summary["states"] == sum(e["length"] for e in summary["episodes"]) > 60
+    assert summary["tsne_points"] == 60
     assert len(np.load(out / "tsne.npz")["embedding"]) == 60
     assert summary["landmark"] == "exit"
     picture(out / "tsne.png")

@@ -8,13 +8,16 @@ import pytest
 import mjmaze
 from mjmaze.tasks import base, labyrinth
 
-from conftest import FORWARD, TURN_LEFT, find_cell, open_run, place, yaw_difference
+from conftest import FORWARD, TURN_LEFT, TURN_RIGHT, find_cell, open_run, place, yaw_difference
 
 
 def test_exit_pays_one_and_ends_the_episode(labyrinth9):
     env = labyrinth9
     ex, ey = env.task.config.cell_centre(env.task.config.object_cells[0])
-    place(env, ex - 0.35, ey, 0.0)  # same cell, 0.35 m short of the exit, facing it
+    place(env, ex - 0.5, ey, 0.0)  # same cell, 0.5 m short of the exit, facing it
+    for _ in range(2):  # from rest: 0.06 m, then 0.12 m (0.32 m short: not yet within 0.3 m)
+        timestep = env.step(FORWARD)
+        assert timestep.mid()
     timestep = env.step(FORWARD)
     assert timestep.last()
     assert timestep.discount == 0.0  # a task end, not a truncation
@@ -41,27 +44,57 @@ def test_time_limit_is_525_agent_steps_and_truncates(labyrinth9):
     assert env.step(TURN_LEFT).first()  # the next step starts a new episode
 
 
-def test_a_free_straight_run_covers_a_quarter_metre_per_step(labyrinth9):
-    env = labyrinth9
-    config = env.task.config
-    cell = find_cell(config, lambda c: open_run(config, c, 2) and c not in config.object_cells)
-    x, y = config.cell_centre(cell)
-    place(env, x, y, 0.0)
-    for k in range(1, 5):
-        env.step(FORWARD)
-        px, py, yaw = env.physics.agent_pose()
-        assert px - x == pytest.approx(0.25 * k, abs=0.01)
-        assert py == pytest.approx(y, abs=1e-6)
+# ViZDoom's own motion, frame skip 4, in its open health_gathering room
+# (`python bench/doom_motion.py`, docs/motion.md): map units (1/128 m) moved and
+# degrees turned per agent step.
+DOOM_FORWARD_FROM_REST = [7.1, 15.6, 21.4, 25.3, 27.9, 29.7, 30.9, 31.7, 32.2, 32.6, 32.8, 33.0]
+DOOM_COASTING = [26.0, 17.5, 11.8, 8.0, 5.4, 3.6]  # keys off forward (here: turning)
+DOOM_TURN_FROM_REST = [7.0, 12.3, 14.1, 14.1, 14.1, 14.1]
 
 
-def test_a_turn_is_fifteen_degrees(labyrinth9):
-    env = labyrinth9
-    yaw0 = env.physics.agent_pose()[2]
-    for k in range(1, 7):
-        env.step(TURN_LEFT)
-        assert yaw_difference(env.physics.agent_pose()[2], yaw0 + math.radians(15 * k)) < math.radians(0.1)
-    env.step(1)  # turn right
-    assert yaw_difference(env.physics.agent_pose()[2], yaw0 + math.radians(75)) < math.radians(0.1)
+@pytest.fixture
+def open_arena():
+    """An empty 10 x 10 m arena (Two-colour at complexity 0), the agent in a corner row facing +x."""
+    env = mjmaze.load("two_colour", task_kwargs={"complexity": 0})
+    env.reset()
+    env.physics.set_agent_pose(-4.0, -3.0, 0.0)
+    yield env
+    env.task.close()
+
+
+def _steps(env, actions):
+    """Distance (map units) and turn (degrees) of each agent step."""
+    moved = []
+    x, y, yaw = env.physics.agent_pose()
+    for action in actions:
+        env.step(action)
+        nx, ny, nyaw = env.physics.agent_pose()
+        moved.append((math.hypot(nx - x, ny - y) / base.MAP_UNIT, math.degrees(math.remainder(nyaw - yaw, math.tau))))
+        x, y, yaw = nx, ny, nyaw
+    return np.array(moved)
+
+
+def test_forward_gathers_speed_and_coasts_as_in_vizdoom(open_arena):
+    moved = _steps(open_arena, [FORWARD] * 12 + [TURN_LEFT] * 6)
+    assert moved[:, 0] == pytest.approx(DOOM_FORWARD_FROM_REST + DOOM_COASTING, abs=0.15)
+    # Full speed: about a quarter metre per step.
+    assert base.FORWARD_PER_STEP == pytest.approx(33.4 * base.MAP_UNIT, abs=0.001)
+
+
+def test_a_turn_starts_slow_as_in_vizdoom(open_arena):
+    moved = _steps(open_arena, [TURN_LEFT] * 6 + [FORWARD] + [TURN_LEFT] * 2 + [TURN_RIGHT, TURN_LEFT])
+    assert moved[:6, 1] == pytest.approx(DOOM_TURN_FROM_REST, abs=0.1)
+    assert moved[6, 1] == pytest.approx(0.0, abs=1e-6)
+    # Letting go of the turn keys restarts the slow start; switching sides does not.
+    assert moved[7:, 1] == pytest.approx([7.0, 12.3, -14.1, 14.1], abs=0.1)
+
+
+def test_momentum_carries_the_agent_on_after_a_turn(open_arena):
+    moved = _steps(open_arena, [FORWARD] * 8 + [TURN_LEFT] * 6)
+    x, y, yaw = open_arena.physics.agent_pose()
+    assert yaw == pytest.approx(math.radians(7.0 + 12.3 + 14.1 * 4), abs=0.01)
+    assert y == pytest.approx(-3.0, abs=1e-6)  # it kept sliding along +x while it turned
+    assert moved[8:, 0].sum() > 0.5 / base.MAP_UNIT
 
 
 def _walled_cell(config):
@@ -101,7 +134,7 @@ def test_the_agent_slides_along_a_wall(labyrinth9):
     x, y = config.cell_centre(cell)
     wall_face = x + config.cell_size / 2 - 0.0625
     place(env, x + 0.2, y - 0.3, math.radians(30))  # heading into the wall at 30 degrees
-    for _ in range(3):
+    for _ in range(6):
         env.step(FORWARD)
     px, py, _ = env.physics.agent_pose()
     assert px < wall_face - 0.05
@@ -183,7 +216,7 @@ def test_a_new_maze_changes_the_walls_the_agent_meets():
                      and c[1] + 1 < 5 and c not in second.object_cells and (c[0], c[1] + 1) not in second.object_cells)
     x, y = second.cell_centre(cell)
     place(env, x, y, 0.0)
-    for _ in range(3):
+    for _ in range(6):  # about 1 m from rest
         env.step(FORWARD)
     assert env.physics.agent_pose()[0] > x + 0.6  # walked through where the old wall stood
     env.task.close()

@@ -35,8 +35,8 @@ class _RunSettings:
     """RMSprop learning rate"""
     alpha: float = 0.99
     """RMSprop smoothing constant"""
-    eps: float = 1e-8
-    """RMSprop epsilon (PyTorch's default; the released 1e-5 never reached the optimiser)"""
+    eps: float = 1e-5
+    """RMSprop epsilon (the released train_a2c.py passes its --eps 1e-5 to RMSprop)"""
     value_coef: float = 0.5
     """weight of the value loss"""
     entropy_coef: float = 0.001

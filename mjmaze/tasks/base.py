@@ -32,9 +32,20 @@ from mjmaze import layouts as layout_files
 # Timing: one physics step is one Doom tic; the agent acts every 4 tics.
 TICS_PER_STEP = 4
 EPISODE_STEPS = 525  # 2100 tics
-# Motion per agent step in open space.
-FORWARD_PER_STEP = 0.25  # metres
-TURN_PER_STEP = math.radians(15.0)
+# Motion: Doom's player movement, tic by tic (ZDoom's P_MovePlayer and
+# P_XYMovement; measured in ViZDoom, see docs/motion.md). A held forward key
+# adds a walking thrust to the velocity each tic and friction keeps 0.90625 of
+# it after the tic's move, so the agent gathers speed over ~3 agent steps and
+# coasts after letting go; a turn key turns 3.52 degrees a tic, half that for
+# the first 5 tics it is held.
+MAP_UNIT = 1 / 128  # metres
+THRUST_PER_TIC = 25 * 2048 / 65536 * MAP_UNIT  # m/tic gained per tic: forwardmove 0x19 (walking)
+FRICTION = 0xE800 / 0x10000  # share of the velocity a tic keeps
+TURN_PER_TIC = math.tau * 640 / 65536  # radians: angleturn 640 of a 65536 turn
+SLOW_TURN_TICS = 5  # a turn key's first tics turn at half rate (ZDoom's SLOWTURNTICS)
+# At full speed in open space: 0.261 m and 14.06 degrees per agent step.
+FORWARD_PER_STEP = TICS_PER_STEP * THRUST_PER_TIC / (1 - FRICTION)
+TURN_PER_STEP = TICS_PER_STEP * TURN_PER_TIC
 PICKUP_RADIUS = rules.PICKUP_RADIUS
 AGENT_RADIUS = 0.125
 
@@ -63,19 +74,26 @@ class MazePhysics(mujoco.Physics):
 
     #: ``(tics, 2)``: the agent's ``(x, y)`` after each tic of the last :meth:`step`.
     tic_xy: np.ndarray = np.zeros((0, 2))
+    #: The keys held during the next :meth:`step`: ``(forward, turn)``, each -1, 0 or 1.
+    command: tuple[int, int] = (0, 0)
+    #: Tics a turn key has been held without a break (Doom's slow start of a turn).
+    turn_held: int = 0
 
     def step(self, nstep: int = 1) -> None:
-        """Advances ``nstep`` tics; walls and pillars stop the agent at its radius.
+        """Advances ``nstep`` tics of :attr:`command`; walls and pillars stop the agent at its radius.
 
-        Collisions are found where the agent will be at the end of the tic
-        (positions moved ahead by ``qvel * dt`` for ``mj_step``, then moved back),
-        and the arena's contacts (see ``xml_templates/arena.xml``) take exactly
-        the predicted penetration out of the velocity. Plain ``mj_step`` finds a
-        contact only after the agent has sunk up to a tic's travel (6 cm) into a
-        wall, then pushes it back: a 6 cm jitter against every wall.
+        Each tic moves the agent as Doom does (:func:`tic_motion`, then
+        friction). Collisions are found where the agent will be at the end of
+        the tic (positions moved ahead by ``qvel * dt`` for ``mj_step``, then
+        moved back), and the arena's contacts (see ``xml_templates/arena.xml``)
+        take exactly the predicted penetration out of the velocity, so momentum
+        into a wall is lost and the rest slides along it. Plain ``mj_step``
+        finds a contact only after the agent has sunk up to a tic's travel
+        (6 cm) into a wall, then pushes it back: a 6 cm jitter against every wall.
         """
         model, data = self.model.ptr, self.data.ptr
         qpos, qvel, dt = data.qpos, data.qvel, model.opt.timestep
+        forward, turn = self.command
         if len(self.tic_xy) != nstep:
             self.tic_xy = np.zeros((nstep, 2))
         tic_xy = self.tic_xy
@@ -83,12 +101,17 @@ class MazePhysics(mujoco.Physics):
             for tic in range(nstep):
                 # Only x and y matter (the agent is a sphere); plain floats beat
                 # numpy calls on 2-element arrays.
+                qvel[0], qvel[1], qvel[2], self.turn_held = tic_motion(
+                    math, qvel[0], qvel[1], qpos[2], forward, turn, self.turn_held, dt
+                )
                 ahead_x, ahead_y = qvel[0] * dt, qvel[1] * dt
                 qpos[0] += ahead_x
                 qpos[1] += ahead_y
                 mj.mj_step(model, data)
                 qpos[0] -= ahead_x
                 qpos[1] -= ahead_y
+                qvel[0] *= FRICTION
+                qvel[1] *= FRICTION
                 tic_xy[tic] = qpos[:2]
 
     def agent_pose(self) -> tuple[float, float, float]:
@@ -99,6 +122,7 @@ class MazePhysics(mujoco.Physics):
     def set_agent_pose(self, x: float, y: float, yaw: float) -> None:
         self.data.qpos[:3] = (x, y, yaw)
         self.data.qvel[:3] = 0.0
+        self.turn_held = 0
 
     def object_ids(self, names: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
         """``(ids for place_objects, geom ids)`` of scenario objects (see :class:`mjmaze.mjcf.ObjectGeom`).
@@ -360,11 +384,7 @@ class MazeTask(base.Task):
     # -- the per-step path ------------------------------------------------
 
     def before_step(self, action, physics: MazePhysics) -> None:
-        forward, turn = self.actions[int(action)]
-        # Plain floats and math (numpy's per-call cost is a fair part of a step here).
-        self._qvel[0], self._qvel[1], self._qvel[2] = agent_velocity(
-            math, forward, turn, float(self._qpos[2]), self._model.opt.timestep
-        )
+        physics.command = self.actions[int(action)]
 
     def after_step(self, physics: MazePhysics) -> None:
         reward, ended, _ = self.step_state(np, self.state, physics.tic_xy[None])
@@ -463,19 +483,21 @@ class MazeTask(base.Task):
         self._bound_data = None
 
 
-def agent_velocity(xp, forward, turn, yaw, timestep: float):
-    """The agent's ``(vx, vy, yaw rate)`` for one step of ``forward`` (-1, 0, 1) and ``turn`` (-1, 0, 1, +1 left).
+def tic_motion(xp, vx, vy, yaw, forward, turn, turn_held, timestep: float):
+    """One tic of Doom's player movement: ``(vx, vy, yaw rate, turn_held)`` to move with this tic.
 
-    Works on floats (``xp = math``) and on arrays (``xp`` an array namespace), so
-    the CPU task and the Warp backend move the agent by the same statement. No
-    actuators: the velocity holds for the step's tics unless a contact takes
-    its normal part away (the agent slides along walls).
+    ``forward`` and ``turn`` (+1 left) are the held keys (-1, 0, 1),
+    ``turn_held`` the tics a turn key was held before this one. Doom turns the
+    player, then thrusts along the new heading; friction (:data:`FRICTION`)
+    follows the tic's move (the caller applies it, after contacts). Works on
+    floats (``xp = math``) and on arrays (``xp`` an array namespace), so the
+    CPU task and the Warp backend move the agent by the same statement.
     """
-    step_seconds = TICS_PER_STEP * timestep
-    # Head along the middle of this step's turn, so a forward+turn step follows the chord of its arc.
-    heading = yaw + 0.5 * turn * TURN_PER_STEP
-    speed = forward * (FORWARD_PER_STEP / step_seconds)
-    return speed * xp.cos(heading), speed * xp.sin(heading), turn * (TURN_PER_STEP / step_seconds)
+    turn_held = (turn_held + 1) * (turn != 0)
+    yaw_rate = turn * TURN_PER_TIC * (1.0 - 0.5 * (turn_held <= SLOW_TURN_TICS)) / timestep
+    heading = yaw + yaw_rate * timestep
+    thrust = forward * THRUST_PER_TIC / timestep
+    return vx + thrust * xp.cos(heading), vy + thrust * xp.sin(heading), yaw_rate, turn_held
 
 
 def make_environment(task: MazeTask, environment_kwargs: dict | None = None) -> control.Environment:

@@ -1,0 +1,80 @@
+"""The agent's motion per agent step, ViZDoom beside mjmaze, in open space.
+
+    python bench/doom_motion.py          # needs ViZDoom: pip install -e ".[bench]"
+
+Plays the same key sequences (frame skip 4) in ViZDoom's open `health_gathering`
+room and in an empty mjmaze arena (Two-colour at complexity 0) and prints, per
+agent step, the distance moved (Doom map units, 1/128 m) and the turn (degrees).
+These figures are where `mjmaze.tasks.base`'s motion constants come from and
+what `tests/test_labyrinth.py` checks (docs/motion.md).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+import mjmaze
+from mjmaze.tasks import base
+
+# Key sequences as indices of the default action set: 0 left, 1 right, 2 forward, 3 forward+left.
+SEQUENCES = {
+    "forward x12, then turn left x6 (coasting)": [2] * 12 + [0] * 6,
+    "turn left x6, forward, turn left x2": [0] * 6 + [2] + [0] * 2,
+    "forward x6, then forward+left x6": [2] * 6 + [3] * 6,
+    "left and right alternating x6": [0, 1] * 3,
+}
+KEYS = {0: [1, 0, 0], 1: [0, 1, 0], 2: [0, 0, 1], 3: [1, 0, 1]}  # TURN_LEFT, TURN_RIGHT, MOVE_FORWARD
+
+
+def doom_steps(actions: list[int]) -> list[tuple[float, float]]:
+    import vizdoom as vzd
+
+    game = vzd.DoomGame()
+    game.load_config(os.path.join(vzd.scenarios_path, "health_gathering.cfg"))
+    game.set_window_visible(False)
+    game.set_sound_enabled(False)
+    game.set_available_buttons([vzd.Button.TURN_LEFT, vzd.Button.TURN_RIGHT, vzd.Button.MOVE_FORWARD])
+    variables = [vzd.GameVariable.POSITION_X, vzd.GameVariable.POSITION_Y, vzd.GameVariable.ANGLE]
+    game.set_available_game_variables(variables)
+    game.set_episode_timeout(100_000)
+    game.init()
+    game.new_episode()
+    for _ in range(6):  # let the spawn settle
+        game.make_action([0, 0, 0], 4)
+    pose = [game.get_game_variable(v) for v in variables]
+    steps = []
+    for action in actions:
+        game.make_action(KEYS[action], 4)
+        new = [game.get_game_variable(v) for v in variables]
+        steps.append((math.hypot(new[0] - pose[0], new[1] - pose[1]), (new[2] - pose[2] + 180) % 360 - 180))
+        pose = new
+    game.close()
+    return steps
+
+
+def mjmaze_steps(actions: list[int]) -> list[tuple[float, float]]:
+    env = mjmaze.load("two_colour", task_kwargs={"complexity": 0})
+    env.reset()
+    env.physics.set_agent_pose(-4.0, -3.0, 0.0)  # a corner row of the empty 10 x 10 m arena, facing +x
+    pose = env.physics.agent_pose()
+    steps = []
+    for action in actions:
+        env.step(action)
+        new = env.physics.agent_pose()
+        turn = math.degrees(math.remainder(new[2] - pose[2], math.tau))
+        steps.append((math.hypot(new[0] - pose[0], new[1] - pose[1]) / base.MAP_UNIT, turn))
+        pose = new
+    env.task.close()
+    return steps
+
+
+def main() -> None:
+    for name, actions in SEQUENCES.items():
+        print(name)
+        for label, steps in (("  ViZDoom", doom_steps(actions)), ("  mjmaze ", mjmaze_steps(actions))):
+            print(label, " ".join(f"{d:5.1f}u/{t:5.1f}°" for d, t in steps))
+
+
+if __name__ == "__main__":
+    main()
