@@ -164,18 +164,29 @@ def test_frames_change_when_the_agent_turns(labyrinth9):
     assert np.abs(before.astype(int) - after.astype(int)).mean() > 1.0
 
 
-def test_the_exit_is_visible_when_faced(labyrinth9):
-    env = labyrinth9
-    ex, ey = env.task.config.cell_centre(env.task.config.object_cells[0])
+def test_the_exit_is_a_small_item_on_the_floor_as_released():
+    # A maze whose exit has two open cells on its -x side, to look at it from 2 m.
+    for index in range(64):
+        env = mjmaze.load("labyrinth", task_kwargs={"size": 5, "first_config": index})
+        env.reset()
+        config = env.task.config
+        row, col = config.object_cells[0]
+        if col >= 2 and not config.v_walls[row, col] and not config.v_walls[row, col - 1]:
+            break
+        env.task.close()
+    ex, ey = config.cell_centre(config.object_cells[0])
+    (exit_geom,) = env.physics.object_ids(["exit"])[1]
 
-    def exit_pixels(yaw):
-        place(env, ex - 0.3, ey, yaw)
-        frame = env.task.get_observation(env.physics)["pixels"].astype(float)
-        # Shaded by the headlight, the exit keeps its hue: strong blue, little red.
-        return ((frame[..., 2] > 150) & (frame[..., 0] < 60)).sum()
+    def exit_pixels(distance, yaw=0.0):
+        place(env, ex - distance, ey, yaw)
+        return int((env.task.segmentation(env.physics) == exit_geom).sum())
 
-    assert exit_pixels(0.0) > 50  # facing it
-    assert exit_pixels(math.pi) == 0  # back turned
+    assert exit_pixels(0.3) > 50  # at its feet, facing it
+    assert exit_pixels(0.3, yaw=math.pi) == 0  # back turned
+    # Doom's green armour (0.24 m wide, 0.125 m high) is a few pixels two cells off:
+    # the agent must come close to spot it.
+    assert 0 < exit_pixels(2.0) < 30
+    env.task.close()
 
 
 def test_cycle_and_random_config_sampling():

@@ -30,8 +30,10 @@ CELL_SIZE = 1.0
 TARGET_REWARD = 0.5
 RETURN_REWARD = 0.5
 STEP_REWARD = -0.0001 * base.TICS_PER_STEP
-PILLAR_RADIUS = 0.125
-PILLAR_HEIGHT = 0.6
+# Doom's tall green and red columns (things 30 and 32), as released: 16 map
+# units in radius, 52 high.
+PILLAR_RADIUS = 16 * base.MAP_UNIT
+PILLAR_HEIGHT = 52 * base.MAP_UNIT
 # The agent spawns this far off the green pillar in -x and -y.
 SPAWN_OFFSET = 0.25
 

@@ -29,7 +29,12 @@ CELL_SIZE = 1.0
 EXIT_REWARD = 1.0
 STEP_REWARD = -0.0001 * base.TICS_PER_STEP
 
-EXIT = mjcf.ObjectGeom("exit", "box", (0.12, 0.12, 0.3), (0.0, 0.6, 1.0, 1.0), z=0.3)
+# The released mazes' exit is Doom's green armour (thing 2018): a pickup lying
+# on the floor, 40 x 16 map units (a 31 x 17 sprite), i.e. 0.12 m in radius and
+# 0.125 m high. A cylinder shows the same width from every side, as a sprite.
+# How small it is decides how far off the agent can spot it (docs/objects.md).
+EXIT_RADIUS, EXIT_HEIGHT = 0.12, 16 * base.MAP_UNIT
+EXIT = mjcf.ObjectGeom("exit", "cylinder", (EXIT_RADIUS, EXIT_HEIGHT / 2), (0.15, 0.65, 0.15, 1.0), z=EXIT_HEIGHT / 2)
 
 
 class Labyrinth(base.MazeTask):
