@@ -28,6 +28,7 @@ def best_view(name: str, task_kwargs: dict) -> np.ndarray:
     env.reset()
     task, physics = env.task, env.physics
     config = task.config
+    object_geoms = physics.object_ids([geom.name for geom in task.objects])[1]
     best, best_score = None, -1
     for row in range(config.size):
         for col in range(config.size):
@@ -35,12 +36,9 @@ def best_view(name: str, task_kwargs: dict) -> np.ndarray:
             for k in range(12):
                 physics.set_agent_pose(x, y, k * math.pi / 6)
                 physics.forward()
-                frame = task.get_observation(physics)["pixels"]
-                # Saturated pixels are objects (walls, floor and sky are muted).
-                rgb = frame.astype(int)
-                score = ((rgb.max(axis=-1) - rgb.min(axis=-1)) > 150).sum()
+                score = np.isin(task.segmentation(physics), object_geoms).sum()
                 if score > best_score:
-                    best, best_score = frame, score
+                    best, best_score = task.get_observation(physics)["pixels"].copy(), score
     task.close()
     return best
 
