@@ -115,6 +115,11 @@ def test_learning_curves_average_seeds_with_train_and_test_evaluations(tmp_path,
     for run in runs:
         assert sorted(p.name for p in (run / "evals").iterdir()) == ["step_000000000160.json", "step_000000000320.json"]
     picture(out)
+    # Variants of one setting (not seeds): a curve per run, named by its folder.
+    curves.main([*map(str, runs), "--each-run", "--out", str(out)])
+    groups = json.loads(out.with_suffix(".json").read_text())
+    assert [g["label"] for g in groups] == ["tc_s0", "tc_s1"]
+    assert [g["training"]["seeds"] for g in groups] == [1, 1]
 
 
 def test_tools_given_a_folder_that_is_no_run_say_so(tmp_path):

@@ -117,19 +117,20 @@ def evaluations(runs: list[dict]) -> dict:
     return out
 
 
-def curves(run_dirs: list[pathlib.Path], bins: int = BINS) -> list[dict]:
-    """One curve per group of seeds, in the order the groups first appear."""
+def curves(run_dirs: list[pathlib.Path], bins: int = BINS, each_run: bool = False) -> list[dict]:
+    """One curve per group of seeds (or, with ``each_run``, per run, named by its folder), in the order they first appear."""
     groups: dict[tuple, list[dict]] = {}
     for run_dir in run_dirs:
         run = read_run(pathlib.Path(run_dir))
-        groups.setdefault(group_key(run["config"]), []).append(run)
+        key = (pathlib.Path(run_dir).name,) if each_run else group_key(run["config"])
+        groups.setdefault(key, []).append(run)
     result = []
-    for runs in groups.values():
+    for key, runs in groups.items():
         config = runs[0]["config"]
         declared = registry.get(config["scenario"])
         paper = declared.paper_curves.get(config.get(declared.difficulty), ()) if not config.get("num_configs") else ()
         result.append({
-            "label": label(config), "scenario": config["scenario"], "units": declared.curve_units,
+            "label": key[0] if each_run else label(config), "scenario": config["scenario"], "units": declared.curve_units,
             "eval_units": declared.metric_units,
             "runs": [r["dir"] for r in runs], "training": binned(runs, bins), "evaluations": evaluations(runs),
             "paper": {"step": [s for s, _ in paper], "value": [v for _, v in paper]},
@@ -143,6 +144,7 @@ def figure(groups: list[dict], title: str = "") -> Figure:
     fig = Figure(figsize=(5.2 * len(scenarios), 4.0))
     axes = np.atleast_1d(fig.subplots(1, len(scenarios), squeeze=False)[0])
     colours = iter([f"C{k}" for k in range(100)])
+    papers_drawn = set()
     for group in groups:
         ax = axes[scenarios.index(group["scenario"])]
         colour = next(colours)
@@ -163,12 +165,14 @@ def figure(groups: list[dict], title: str = "") -> Figure:
             ax.errorbar(ev["step"], ev["test_mean"], yerr=ev["test_std"], color=colour, marker="x", linestyle="--",
                         markersize=5, capsize=2, linewidth=0.8)
         paper = group.get("paper", {"step": []})
-        if paper["step"]:
+        paper_key = (group["scenario"], tuple(paper["step"]), tuple(paper.get("value", ())))
+        if paper["step"] and paper_key not in papers_drawn:
+            papers_drawn.add(paper_key)
             # Only the paper's points within (a little beyond) the steps ours reach: its 200M would squash ours.
             reach = max([*group["training"]["step"], *ev["step"], 0]) * 2.2
             shown = [(x, y) for x, y in zip(paper["step"], paper["value"]) if x <= max(reach, paper["step"][0])]
             ax.plot(*zip(*shown), color="black", marker="s", linestyle=":", markersize=4,
-                    label=f"paper, {group['label']} (read off its plots)")
+                    label="paper (read off its plots)")
     for ax, scenario in zip(axes, scenarios):
         ax.set_title(scenario, fontsize=10)
         ax.set_xlabel("agent steps (observations)")
@@ -196,12 +200,14 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--evaluate", action="store_true", help="evaluate kept checkpoints not evaluated yet")
     parser.add_argument("--num-envs", type=int, default=16, help="parallel envs for --evaluate (must divide 64)")
     parser.add_argument("--bins", type=int, default=BINS)
+    parser.add_argument("--each-run", action="store_true",
+                        help="a curve per run, named by its folder (to compare variants, not seeds)")
     args = parser.parse_args(argv)
     try:
         if args.evaluate:
             for run_dir in args.runs:
                 evaluate_checkpoints(run_dir, args.num_envs)
-        groups = curves(args.runs, args.bins)
+        groups = curves(args.runs, args.bins, each_run=args.each_run)
     except (checkpoint.CheckpointError, FileNotFoundError, ValueError) as error:
         raise SystemExit(f"error: {error}") from None
     write(groups, args.out)
