@@ -97,22 +97,25 @@ class MazePhysics(mujoco.Physics):
         if len(self.tic_xy) != nstep:
             self.tic_xy = np.zeros((nstep, 2))
         tic_xy = self.tic_xy
+        # Plain floats and math between the tics: numpy's per-call cost on
+        # 1-element reads and writes is a fair part of a tic here.
+        vx, vy, held = float(qvel[0]), float(qvel[1]), self.turn_held
         with self.check_invalid_state():
             for tic in range(nstep):
-                # Only x and y matter (the agent is a sphere); plain floats beat
-                # numpy calls on 2-element arrays.
-                qvel[0], qvel[1], qvel[2], self.turn_held = tic_motion(
-                    math, qvel[0], qvel[1], qpos[2], forward, turn, self.turn_held, dt
-                )
-                ahead_x, ahead_y = qvel[0] * dt, qvel[1] * dt
+                vx, vy, yaw_rate, held = tic_motion(math, vx, vy, float(qpos[2]), forward, turn, held, dt)
+                qvel[0], qvel[1], qvel[2] = vx, vy, yaw_rate
+                # Only x and y matter (the agent is a sphere).
+                ahead_x, ahead_y = vx * dt, vy * dt
                 qpos[0] += ahead_x
                 qpos[1] += ahead_y
                 mj.mj_step(model, data)
                 qpos[0] -= ahead_x
                 qpos[1] -= ahead_y
-                qvel[0] *= FRICTION
-                qvel[1] *= FRICTION
+                # The contacts took away the velocity into walls; friction keeps a share of the rest.
+                vx, vy = float(qvel[0]) * FRICTION, float(qvel[1]) * FRICTION
                 tic_xy[tic] = qpos[:2]
+        qvel[0], qvel[1] = vx, vy
+        self.turn_held = held
 
     def agent_pose(self) -> tuple[float, float, float]:
         """``(x, y, yaw)`` of the agent; yaw in radians in ``(-pi, pi]``, 0 facing +x."""
