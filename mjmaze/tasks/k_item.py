@@ -37,6 +37,8 @@ CELL_SIZE = 1.25
 NEXT_ITEM_REWARD = 0.5
 WRONG_ITEM_REWARD = -0.25
 STEP_REWARD = -0.0001 * base.TICS_PER_STEP
+
+
 def _floor_item(name: str, shape: str, width: float, height: float, rgba) -> mjcf.ObjectGeom:
     """An item lying on the floor, ``width`` x ``height`` map units as its Doom sprite."""
     radius, height = width / 2 * base.MAP_UNIT, height * base.MAP_UNIT
