@@ -93,7 +93,7 @@ class KItem(base.MazeTask):
         }
 
     def rules(self, xp, state, path):
-        # Items are in cells 1.25 m apart: one step (0.25 m) reaches at most
+        # Items are in cells 1.25 m apart: one step (at most 0.27 m) reaches at most
         # one of them, at any of its tics.
         reached = rules.reached(xp, state["object_xy"], path) & state["object_shown"]
         is_next = rules.one_hot(xp, state["next"], self.num_items)
