@@ -130,7 +130,7 @@ def curves(run_dirs: list[pathlib.Path], bins: int = BINS, each_run: bool = Fals
         declared = registry.get(config["scenario"])
         paper = declared.paper_curves.get(config.get(declared.difficulty), ()) if not config.get("num_configs") else ()
         result.append({
-            "label": key[0] if each_run else label(config), "scenario": config["scenario"], "units": declared.curve_units,
+            "label": key[0] if each_run else label(config), "setting": label(config), "scenario": config["scenario"], "units": declared.curve_units,
             "eval_units": declared.metric_units,
             "runs": [r["dir"] for r in runs], "training": binned(runs, bins), "evaluations": evaluations(runs),
             "paper": {"step": [s for s, _ in paper], "value": [v for _, v in paper]},
@@ -172,7 +172,7 @@ def figure(groups: list[dict], title: str = "") -> Figure:
             reach = max([*group["training"]["step"], *ev["step"], 0]) * 2.2
             shown = [(x, y) for x, y in zip(paper["step"], paper["value"]) if x <= max(reach, paper["step"][0])]
             ax.plot(*zip(*shown), color="black", marker="s", linestyle=":", markersize=4,
-                    label="paper (read off its plots)")
+                    label=f"paper, {group.get('setting', group['label'])} (read off its plots)")
     for ax, scenario in zip(axes, scenarios):
         ax.set_title(scenario, fontsize=10)
         ax.set_xlabel("agent steps (observations)")
