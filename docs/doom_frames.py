@@ -1,20 +1,24 @@
-"""What the agent sees in ViZDoom and in mjmaze, same maze, same pose: ``python docs/doom_frames.py``.
+"""What the agent sees in ViZDoom and in mjmaze, same map, same pose.
 
-Needs ViZDoom (``pip install -e ".[bench]"``). Builds the Doom map of an
-mjmaze Labyrinth maze the way the paper's released generator
-(``scenario_generation/generate_labyrinth.py``) builds its own: each wall
-segment a 16-unit-thick block of ``STONE2``, ``FLAT1_1`` floor, ``MFLR8_1``
-ceiling 128 units up, the sector at UDMF's default light (160), the exit a
-green armour (thing 2018). ViZDoom draws it with the released settings (320x180,
-the pistol shown, no HUD) and the released env's area resize to 112x64; mjmaze
-draws the same pose. Poses look down a straight corridor at the exit from 1 to 6
-cells away. Writes ``docs/doom_vs_mjmaze.png`` (rows: distance; columns:
-ViZDoom, mjmaze; 2x) and prints, per distance, the exit's size in pixels and
-the mean brightness of exit, walls and floor in each.
+    python docs/doom_frames.py              # docs/doom_vs_mjmaze.png: the Labyrinth exit from 1-3 cells
+    python docs/doom_frames.py --calibrate  # colours of walls, floor, ceiling and objects, both engines
+
+Needs ViZDoom (``pip install -e ".[bench]"``; it draws Freedoom's textures and
+sprites, as the paper's runs did). The Doom map of an mjmaze maze is built the
+way the paper's released generators (``scenario_generation/``) build theirs:
+each wall segment a 16-unit-thick block, the room's textures, the ceiling 128
+units up, the sector at UDMF's default light (160, none is set), things by the
+released type numbers. ViZDoom draws it with the released settings (320x180,
+the pistol shown, no HUD) and the released env's area resize to 112x64.
+``--calibrate`` prints ViZDoom's mean colours beside mjmaze's: where
+``mjmaze.mjcf``'s rooms and lamp and the scenarios' object colours come from
+(docs/look.md), and what ``tests/test_look.py`` holds.
 """
 
 from __future__ import annotations
 
+import argparse
+import dataclasses
 import math
 import pathlib
 import struct
@@ -24,56 +28,59 @@ import imageio.v3 as iio
 import numpy as np
 
 import mjmaze
-from mjmaze import configs
-from mjmaze.tasks import base
+from mjmaze import configs, maze, render
+from mjmaze.tasks import base, find_return, two_colour
 
-UNITS = 128  # Doom map units per metre (mjmaze's cell is 1 m = 128 units, as the generator's)
+UNITS = 128  # Doom map units per metre (mjmaze's 1 m cell is the generator's 128 units)
 WALL_PAD = 8  # the generator's half thickness of a wall block
-EXIT_TID = 21
-DOOM_SIZE = (320, 180)  # the released env's screen (RES_320X180)
 SIZE = (112, 64)
+ANIMATION_TICS = 13  # Doom's armour sprites: ARM1 A 6 tics, B (bright) 7
+RAISE_TICS = 8  # the pistol is still being raised for ~6 tics after the released start (tic 10)
+# Doom textures of the released rooms: (walls, floor, ceiling).
+STONE = ("STONE2", "FLAT1_1", "MFLR8_1")  # Labyrinth, Find-and-return, K-item
+SLIME = ("GSTONE1", "NUKAGE1", "CEIL4_1")  # Two-colour
+GREEN_ARMOUR, BLUE_ARMOUR, GREEN_COLUMN, RED_COLUMN = 2018, 2019, 30, 32
+# Wall patch (centre of the frame), floor band and ceiling band of a 112x64 frame.
+WALL_PATCH = (slice(24, 32), slice(50, 62))
+FLOOR_BAND = (slice(40, 64), slice(0, 40))  # the floor from ~2 m to the frame's foot, left of the pistol
+CEILING_BAND = (slice(0, 6), slice(30, 82))
 
 
-def wall_segments(config: configs.MazeConfig) -> list[tuple[float, float, float, float]]:
-    """Interior wall segments ``(x0, y0, x1, y1)`` in map units (the exterior is the sector's edge)."""
-    n, cell = config.size, config.cell_size * UNITS
-    low = -n / 2 * cell
-    segments = []
-    for line in range(1, n):  # interior grid lines only
-        for i in range(n):
-            if config.h_walls[line, i]:  # horizontal wall between rows line-1 and line
-                y = low + line * cell
-                segments.append((low + i * cell, y, low + (i + 1) * cell, y))
-            if config.v_walls[i, line]:  # vertical wall between columns line-1 and line
-                x = low + line * cell
-                segments.append((x, low + i * cell, x, low + (i + 1) * cell))
-    return segments
+@dataclasses.dataclass
+class Thing:
+    x: float  # map units
+    y: float
+    type: int
 
 
-def textmap(config: configs.MazeConfig, spawn: tuple[float, float, float], exit_xy: tuple[float, float]) -> str:
-    """The UDMF map, laid out as ``generate_labyrinth.create_maze`` writes it."""
+def textmap(config: configs.MazeConfig, spawn: tuple[float, float, int], things: list[Thing],
+            textures: tuple[str, str, str] = STONE) -> str:
+    """The UDMF map of ``config``'s walls, laid out as the released generators write theirs."""
     n, cell = config.size, config.cell_size * UNITS
     half = n / 2 * cell
+    low = -half
     polygons = [[(-half, -half), (-half, half), (half, half), (half, -half)]]
-    for x0, y0, x1, y1 in wall_segments(config):
-        if x0 == x1:
-            polygons.append([(x0 - WALL_PAD, y0), (x1 + WALL_PAD, y0), (x1 + WALL_PAD, y1), (x0 - WALL_PAD, y1)])
-        else:
-            polygons.append([(x0, y0 - WALL_PAD), (x1, y0 - WALL_PAD), (x1, y1 + WALL_PAD), (x0, y1 + WALL_PAD)])
-    lines = ['namespace="zdoom";']
+    for line in range(1, n):  # interior grid lines; the outer wall is the sector's edge
+        for i in range(n):
+            if config.h_walls[line, i]:
+                y = low + line * cell
+                x0, x1 = low + i * cell, low + (i + 1) * cell
+                polygons.append([(x0, y - WALL_PAD), (x1, y - WALL_PAD), (x1, y + WALL_PAD), (x0, y + WALL_PAD)])
+            if config.v_walls[i, line]:
+                x = low + line * cell
+                y0, y1 = low + i * cell, low + (i + 1) * cell
+                polygons.append([(x - WALL_PAD, y0), (x + WALL_PAD, y0), (x + WALL_PAD, y1), (x - WALL_PAD, y1)])
+    wall, floor, ceiling = textures
     flags = "coop=true; dm=true; single=true; skill1=true; skill2=true; skill3=true; skill4=true; skill5=true;"
-    x, y, angle = spawn
-    lines.append(f"thing {{ x={x:.3f}; y={y:.3f}; angle={angle}; type=1; {flags} }}")
-    lines.append(f"thing {{ x={exit_xy[0]:.3f}; y={exit_xy[1]:.3f}; type=2018; id={EXIT_TID}; {flags} }}")
-    vertex = 0
-    for polygon in polygons:
-        for vx, vy in polygon:
-            lines.append(f"vertex {{ x={vx:.3f}; y={vy:.3f}; }}")
+    lines = ['namespace="zdoom";', f"thing {{ x={spawn[0]:.3f}; y={spawn[1]:.3f}; angle={spawn[2]}; type=1; {flags} }}"]
+    lines += [f"thing {{ x={t.x:.3f}; y={t.y:.3f}; type={t.type}; {flags} }}" for t in things]
+    for p, polygon in enumerate(polygons):
+        lines += [f"vertex {{ x={vx:.3f}; y={vy:.3f}; }}" for vx, vy in polygon]
         for k in range(4):
-            lines.append(f"linedef {{ v1={vertex + k}; v2={vertex + (k + 1) % 4}; sidefront={vertex + k}; blocking=true; }}")
-            lines.append('sidedef { sector=0; texturemiddle="STONE2"; }')
-        vertex += 4
-    lines.append('sector { texturefloor="FLAT1_1"; textureceiling="MFLR8_1"; heightceiling=128; }')
+            v1, v2 = 4 * p + k, 4 * p + (k + 1) % 4
+            lines.append(f"linedef {{ v1={v1}; v2={v2}; sidefront={v1}; blocking=true; }}")
+            lines.append(f'sidedef {{ sector=0; texturemiddle="{wall}"; }}')
+    lines.append(f'sector {{ texturefloor="{floor}"; textureceiling="{ceiling}"; heightceiling=128; }}')
     return "\n".join(lines) + "\n"
 
 
@@ -88,8 +95,8 @@ def write_wad(path: pathlib.Path, text: str) -> None:
     path.write_bytes(b"PWAD" + struct.pack("<ii", len(lumps), offset) + data + directory)
 
 
-def area_resize(frame: np.ndarray, size: tuple[int, int]) -> np.ndarray:
-    """Mean over each output pixel's footprint (what cv2.INTER_AREA does, as the released env resizes)."""
+def area_resize(frame: np.ndarray, size: tuple[int, int] = SIZE) -> np.ndarray:
+    """Mean over each output pixel's footprint (cv2.INTER_AREA, as the released env resizes)."""
     h, w = frame.shape[:2]
     rows = np.minimum((np.arange(h) * size[1]) // h, size[1] - 1)
     cols = np.minimum((np.arange(w) * size[0]) // w, size[0] - 1)
@@ -100,13 +107,13 @@ def area_resize(frame: np.ndarray, size: tuple[int, int]) -> np.ndarray:
     return out / weight.reshape(weight.shape + (1,) * (frame.ndim - 2))
 
 
-def doom_view(config, spawn, exit_xy) -> tuple[np.ndarray, np.ndarray]:
-    """ViZDoom's 112x64 frame and the exit's share of each pixel (0..1)."""
+def doom_view(text: str, weapon: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """ViZDoom's 112x64 frame of map ``text`` and the share of each pixel covered by things."""
     import vizdoom as vzd
 
     with tempfile.TemporaryDirectory() as folder:
         wad = pathlib.Path(folder) / "maze.wad"
-        write_wad(wad, textmap(config, spawn, exit_xy))
+        write_wad(wad, text)
         game = vzd.DoomGame()
         game.set_doom_scenario_path(str(wad))
         game.set_doom_map("map01")
@@ -114,82 +121,85 @@ def doom_view(config, spawn, exit_xy) -> tuple[np.ndarray, np.ndarray]:
         game.set_screen_format(vzd.ScreenFormat.RGB24)
         game.set_render_hud(False)
         game.set_render_crosshair(False)
-        game.set_render_weapon(True)
+        game.set_render_weapon(weapon)
         game.set_render_decals(False)
         game.set_render_particles(False)
         game.set_labels_buffer_enabled(True)
         game.set_window_visible(False)
         game.set_sound_enabled(False)
-        game.set_episode_start_time(10)  # the released cfg: the pistol is up
+        game.set_episode_start_time(10)  # as the released cfg
         game.set_available_buttons([vzd.Button.MOVE_FORWARD])
         game.set_doom_skill(5)
         game.init()
         game.new_episode()
-        state = game.get_state()
-        screen = state.screen_buffer.copy()
-        exit_mask = np.zeros(screen.shape[:2])
-        for label in state.labels:
-            if label.object_name == "GreenArmor":
-                exit_mask[state.labels_buffer == label.value] = 1.0
+        game.advance_action(RAISE_TICS)
+        # Armour blinks (a plain frame 6 tics, a bright one 7): average a whole cycle.
+        screens, masks = [], []
+        for _ in range(ANIMATION_TICS):
+            state = game.get_state()
+            things = [label.value for label in state.labels if label.object_name != "DoomPlayer"]
+            screens.append(area_resize(state.screen_buffer))
+            masks.append(area_resize(np.isin(state.labels_buffer, things).astype(np.float64)))
+            game.advance_action(1)
         game.close()
-    return area_resize(screen, SIZE).round().astype(np.uint8), area_resize(exit_mask, SIZE)
+    return np.mean(screens, axis=0).round().astype(np.uint8), np.mean(masks, axis=0)
 
 
-def mjmaze_view(env, spawn) -> tuple[np.ndarray, np.ndarray]:
-    """mjmaze's 112x64 frame and its exit mask."""
+def mjmaze_view(env, spawn: tuple[float, float, int], objects: list[str]) -> tuple[np.ndarray, np.ndarray]:
+    """mjmaze's 112x64 frame at ``spawn`` (map units, degrees) and where ``objects`` are seen."""
     task, physics = env.task, env.physics
-    x, y, angle = spawn
-    physics.set_agent_pose(x / UNITS, y / UNITS, math.radians(angle))
+    physics.set_agent_pose(spawn[0] / UNITS, spawn[1] / UNITS, math.radians(spawn[2]))
     physics.forward()
-    exit_geom = physics.object_ids([task.objects[0].name])[1]
-    mask = np.isin(task.segmentation(physics), exit_geom).astype(np.float64)
+    geoms = physics.object_ids(objects)[1]
+    mask = np.isin(task.segmentation(physics), geoms).astype(np.float64)
+    rows, cols, _ = render.pistol_pixels(*SIZE)
+    mask[rows, cols] = 0.0  # what the pistol hides
     return task.get_observation(physics)["pixels"].copy(), mask
 
 
-def corridor_poses(config: configs.MazeConfig, exit_cell: tuple[int, int]) -> dict[int, tuple[int, int, int]]:
-    """For each distance in cells, a cell in a straight open line to the exit and the heading (degrees) facing it."""
-    from mjmaze import maze
-
+def corridor_poses(config: configs.MazeConfig, cell: tuple[int, int]) -> dict[int, tuple[int, int, int]]:
+    """Per distance in cells, a cell in a straight open line to ``cell`` and the heading (degrees) facing it."""
     poses = {}
     for (dr, dc), angle in (((1, 0), 270), ((-1, 0), 90), ((0, 1), 180), ((0, -1), 0)):
-        cell, distance = exit_cell, 0
-        while maze.is_open(config.h_walls, config.v_walls, cell, (dr, dc)):
-            cell, distance = (cell[0] + dr, cell[1] + dc), distance + 1
-            poses.setdefault(distance, (cell[0], cell[1], angle))
+        at, distance = cell, 0
+        while maze.is_open(config.h_walls, config.v_walls, at, (dr, dc)):
+            at, distance = (at[0] + dr, at[1] + dc), distance + 1
+            poses.setdefault(distance, (at[0], at[1], angle))
     return poses
 
 
-def brightness(frame: np.ndarray, mask: np.ndarray) -> float:
-    return float(frame.mean(axis=2)[mask].mean()) if mask.any() else math.nan
+def mean_colour(frame: np.ndarray, where) -> list[int]:
+    pixels = frame[where] if not isinstance(where, np.ndarray) else frame[where > 0.5]
+    return np.round(pixels.reshape(-1, 3).mean(axis=0)).astype(int).tolist() if pixels.size else [-1, -1, -1]
 
 
-def main() -> None:
+def scenario_maze(scenario: str, task_kwargs: dict, cell_of) -> tuple:
+    """The first of seeds 0.. whose first training maze has the longest straight view of a cell."""
     best = None
-    for seed in range(20):  # the first training maze (of seeds 0..) with the longest straight view of its exit
-        env = mjmaze.load("labyrinth", task_kwargs={"size": 7, "random": seed})
+    for seed in range(20):
+        env = mjmaze.load(scenario, task_kwargs={**task_kwargs, "random": seed})
         env.reset()
         config = env.task.config
-        poses = corridor_poses(config, config.object_cells[0])
+        poses = corridor_poses(config, cell_of(config))
         if best is None or len(poses) > len(best[2]):
+            if best is not None:
+                best[0].task.close()
             best = (env, config, poses)
-    env, config, poses = best
-    ex, ey = (c * UNITS for c in config.cell_centre(config.object_cells[0]))
+        else:
+            env.task.close()
+    return best
+
+
+def exit_figure() -> None:
+    """docs/doom_vs_mjmaze.png: the Labyrinth 7 exit from 1, 2, 3 cells, ViZDoom | mjmaze."""
+    env, config, poses = scenario_maze("labyrinth", {"size": 7}, lambda c: c.object_cells[0])
+    exit_x, exit_y = (c * UNITS for c in config.cell_centre(config.object_cells[0]))
     rows = []
-    print("cells  exit px (Doom / mjmaze)  exit brightness  wall brightness  floor brightness")
-    for distance, (row, col, angle) in sorted(poses.items()):
-        sx, sy = (c * UNITS for c in config.cell_centre((row, col)))
-        spawn = (sx, sy, angle)
-        doom, doom_exit = doom_view(config, spawn, (ex, ey))
-        ours, our_exit = mjmaze_view(env, spawn)
-        # Walls fill the upper half, the floor the lower (outside the exit and the pistol's column).
-        upper = np.zeros(ours.shape[:2], bool)
-        upper[: SIZE[1] // 2 - 4] = True
-        lower = np.zeros_like(upper)
-        lower[SIZE[1] // 2 + 6:, : SIZE[0] // 3] = True
-        print(f"{distance:5d}  {doom_exit.sum():7.1f} / {our_exit.sum():6.1f}"
-              f"        {brightness(doom, doom_exit > 0.5):5.0f} / {brightness(ours, our_exit > 0.5):5.0f}"
-              f"    {brightness(doom, upper):5.0f} / {brightness(ours, upper):5.0f}"
-              f"    {brightness(doom, lower):5.0f} / {brightness(ours, lower):5.0f}")
+    for distance in (1, 2, 3):
+        row, col, angle = poses[distance]
+        spawn = (*(c * UNITS for c in config.cell_centre((row, col))), angle)
+        doom, _ = doom_view(textmap(config, spawn, [Thing(exit_x, exit_y, GREEN_ARMOUR)]))
+        ours, _ = mjmaze_view(env, spawn, ["exit"])
         rows.append(np.concatenate([doom, np.full((SIZE[1], 4, 3), 255, np.uint8), ours], axis=1))
     env.task.close()
     gap = np.full((4, rows[0].shape[1], 3), 255, np.uint8)
@@ -197,6 +207,92 @@ def main() -> None:
     out = pathlib.Path(__file__).parent / "doom_vs_mjmaze.png"
     iio.imwrite(out, image.repeat(2, axis=0).repeat(2, axis=1))
     print(out)
+
+
+def empty_arena(room: str):
+    """An empty 10 m arena (Two-colour at complexity 0) coloured as ``room``, its objects hidden."""
+    from mjmaze import mjcf
+
+    task = two_colour.TwoColour(complexity=0, item_cap=0)
+    task.room = {"stone": mjcf.STONE_ROOM, "slime": mjcf.SLIME_ROOM}[room]
+    env = base.make_environment(task)
+    env.reset()
+    env.physics.show_objects(env.physics.object_ids([o.name for o in task.objects])[1], False)
+    return env
+
+
+def calibrate() -> None:
+    """Prints mean colours (0-255, 112x64 frames) in ViZDoom and mjmaze, side by side."""
+    print("surfaces: an empty 10 m room, facing a wall d metres ahead (Doom | mjmaze)")
+    for room, textures in (("stone", STONE), ("slime", SLIME)):
+        env = empty_arena(room)
+        config = env.task.config
+        edge = config.size * config.cell_size / 2 * UNITS
+        for d in (0.5, 1, 2, 4):
+            spawn = (edge - d * UNITS - WALL_PAD, 0.0, 0)  # mjmaze's outer wall face is 8 units in
+            doom, _ = doom_view(textmap(config, spawn, [], textures), weapon=False)
+            ours, _ = mjmaze_view(env, spawn, [])
+            print(f"  {room:5s} wall at {d} m: {mean_colour(doom, WALL_PATCH)} | {mean_colour(ours, WALL_PATCH)}"
+                  + (f"   floor band: {mean_colour(doom, FLOOR_BAND)} | {mean_colour(ours, FLOOR_BAND)}"
+                     f"   ceiling band: {mean_colour(doom, CEILING_BAND)} | {mean_colour(ours, CEILING_BAND)}"
+                     if d == 4 else ""))
+        env.task.close()
+    print("objects straight ahead down a corridor, cells:  (Doom | mjmaze), mean colour where drawn")
+    cases = [
+        ("labyrinth exit (green armour)", "labyrinth", {"size": 7}, lambda c: c.object_cells[0],
+         lambda c: [Thing(*cell_xy(c, c.object_cells[0]), GREEN_ARMOUR)], ["exit"]),
+        ("find-return red pillar (tall red column)", "find_return", {"size": 7}, lambda c: c.object_cells[0],
+         lambda c: [Thing(*cell_xy(c, c.object_cells[0]), RED_COLUMN)], [find_return.RED_PILLAR.name]),
+    ]
+    for label, scenario, kwargs, cell_of, things_of, objects in cases:
+        env, config, poses = scenario_maze(scenario, kwargs, cell_of)
+        if scenario == "find_return":  # only the red pillar in view: hide the green one
+            env.physics.show_objects(env.physics.object_ids([find_return.GREEN_PILLAR.name])[1], False)
+        results = []
+        for distance in sorted(poses)[:3]:
+            row, col, angle = poses[distance]
+            spawn = (*(c * UNITS for c in config.cell_centre((row, col))), angle)
+            doom, doom_mask = doom_view(textmap(config, spawn, things_of(config)), weapon=False)
+            ours, our_mask = mjmaze_view(env, spawn, objects)
+            results.append(f"{distance}: {mean_colour(doom, doom_mask)} | {mean_colour(ours, our_mask)}")
+        print(f"  {label}: " + "   ".join(results))
+        env.task.close()
+    print("Two-colour objects d metres ahead in the empty arena, 1 / 2 / 3 m (Doom | mjmaze)")
+    env = empty_arena("slime")
+    config = env.task.config
+    physics = env.physics
+    for label, doom_type, name, rgba in (
+        ("green item (green armour)", GREEN_ARMOUR, two_colour.ITEMS[0].name, two_colour.ITEM_GREEN),
+        ("red item (Freedoom's blue armour, red)", BLUE_ARMOUR, two_colour.ITEMS[0].name, two_colour.ITEM_RED),
+        ("green totem (tall green column)", GREEN_COLUMN, two_colour.TOTEM.name, two_colour.GREEN),
+        ("red totem (tall red column)", RED_COLUMN, two_colour.TOTEM.name, two_colour.RED),
+    ):
+        ids = physics.object_ids([name])
+        physics.set_object_rgba(ids[1][0], rgba)
+        physics.show_objects(ids[1], True)
+        results = []
+        for d in (1, 2, 3):
+            physics.place_objects(ids[0], np.array([[d, 0.0]]))
+            doom, doom_mask = doom_view(textmap(config, (0.0, 0.0, 0), [Thing(d * UNITS, 0.0, doom_type)], SLIME),
+                                        weapon=False)
+            ours, our_mask = mjmaze_view(env, (0.0, 0.0, 0), [name])
+            results.append(f"{mean_colour(doom, doom_mask)} | {mean_colour(ours, our_mask)}")
+        physics.show_objects(ids[1], False)
+        print(f"  {label}: " + "   ".join(results))
+    env.task.close()
+
+
+def cell_xy(config: configs.MazeConfig, cell: tuple[int, int]) -> tuple[float, float]:
+    return tuple(c * UNITS for c in config.cell_centre(cell))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--calibrate", action="store_true", help="print colours instead of drawing the figure")
+    if parser.parse_args().calibrate:
+        calibrate()
+    else:
+        exit_figure()
 
 
 if __name__ == "__main__":

@@ -29,15 +29,53 @@ import numpy as np
 #: with distance, the depth cues of the paper's ViZDoom frames; "flat" gives
 #: single-colour surfaces under a headlight, cheaper to render.
 VISUAL_STYLES = ("textured", "flat")
+
+
+@dataclasses.dataclass(frozen=True)
+class Room:
+    """The mean colours (0-1) of a scenario's walls, floor and ceiling.
+
+    They are the released scenario's Doom textures as ViZDoom draws them at
+    the released sector light (160), divided by the lamp's brightness
+    (:func:`_add_distance_falloff`): ``python docs/doom_frames.py --calibrate``
+    prints ViZDoom's colours beside mjmaze's (docs/look.md).
+    """
+
+    wall: tuple[float, float, float]
+    floor: tuple[float, float, float]
+    ceiling: tuple[float, float, float]
+
+
+#: Labyrinth, Find-and-return and K-item: ``STONE2`` walls (grey), ``FLAT1_1``
+#: floor (brown), ``MFLR8_1`` ceiling (grey), as the released generators write them.
+STONE_ROOM = Room(wall=(0.33, 0.33, 0.33), floor=(0.52, 0.40, 0.19), ceiling=(0.34, 0.34, 0.34))
+#: Two-colour: ``GSTONE1`` walls (green-grey), ``NUKAGE1`` floor (green slime), ``CEIL4_1`` ceiling.
+SLIME_ROOM = Room(wall=(0.39, 0.42, 0.28), floor=(0.20, 0.40, 0.13), ceiling=(0.0, 0.0, 0.20))
+#: Doom's tall green and red columns (things 30, 32: Find-and-return's pillars,
+#: Two-colour's totem) as ViZDoom draws them, on a cylinder of their radius.
+TALL_GREEN_COLUMN_RGBA = (0.24, 0.51, 0.17, 1.0)
+TALL_RED_COLUMN_RGBA = (0.73, 0.06, 0.04, 1.0)
+#: Ambient light everywhere, then a lamp at the eye adding ``LAMP_DIFFUSE x cos / (0.05 + d)``
+#: at ``d`` metres: Doom's light diminishing at sector light 160, which ViZDoom
+#: draws as 27 + 12 / d grey levels on a ``STONE2`` wall ``d`` map cells ahead.
+AMBIENT = 0.28
+LAMP_DIFFUSE = 0.30
+LAMP_ATTENUATION = (0.05, 1.0, 0.0)
+#: Side of the floor's and ceiling's quads: lighting is computed at their
+#: corners. With 1 m quads the floor under the eye flashed 2.5x brighter each
+#: time the agent passed a corner; 0.5 m keeps it within ~15% and costs ~3% of a
+#: frame on llvmpipe (0.25 m: 30%).
+LIT_QUAD = 0.5
 TEXTURE_TEXELS = 64  # per side of a texture; one texture covers 1 m x 1 m
 # 1 / the mean grey of each texture (see _brick_texels, _tile_texels).
-_TEXTURE_GAIN = {"wall": 1.35, "floor": 1.55}
+_TEXTURE_GAIN = {"wall": 1.35, "floor": 1.6}
 WALL_THICKNESS = 0.125
 WALL_HEIGHT = 1.0
 WALL_MESH = "walls"
 OVERHEAD_CAMERA = "overhead"
 OVERHEAD_HEIGHT = 10.0
 LAMP = "lamp"
+CEILING_GROUP = 2
 EYE_HEIGHT = 0.32  # the ego camera's height (xml_templates/arena.xml)
 
 # Per wall box in the visual mesh: 4 side faces + the top (the bottom is never
@@ -102,9 +140,10 @@ def overhead_extent(grid_size: int, cell_size: float) -> float:
 
 
 def build_xml(
-    grid_size: int, cell_size: float, objects: Sequence[ObjectGeom] = (), visual_style: str = "textured"
+    grid_size: int, cell_size: float, objects: Sequence[ObjectGeom] = (), visual_style: str = "textured",
+    room: Room = STONE_ROOM,
 ) -> str:
-    """The MJCF of an arena for ``grid_size x grid_size`` cells of ``cell_size`` metres.
+    """The MJCF of an arena for ``grid_size x grid_size`` cells of ``cell_size`` metres, coloured as ``room``.
 
     A ``"textured"`` model needs :func:`paint_textures` after compiling.
     """
@@ -113,6 +152,9 @@ def build_xml(
     root = ET.fromstring(template_path().read_text())
     worldbody = root.find("worldbody")
     asset = root.find("asset")
+    for name in ("wall", "floor", "ceiling"):
+        ET.SubElement(asset, "material", name=name, rgba=" ".join(f"{v:.3f}" for v in getattr(room, name)) + " 1",
+                      specular="0", shininess="0", reflectance="0")
     if visual_style == "textured":
         _add_textures(root)
     segments = wall_segments(grid_size, cell_size)
@@ -125,10 +167,15 @@ def build_xml(
     # The floor after the walls: MuJoCo draws geoms in model order, so floor
     # pixels hidden by walls fail the depth test before any shading.
     half_extent = grid_size * cell_size / 2 + WALL_THICKNESS
-    # Plane grid spacing of one cell: a fine grid makes llvmpipe ~10x slower.
+    # Plane grid spacing LIT_QUAD: finer grids cost llvmpipe more per frame.
     ET.SubElement(
         worldbody, "geom", name="floor", type="plane", material="floor",
-        size=f"{half_extent} {half_extent} {cell_size}",
+        size=f"{half_extent} {half_extent} {LIT_QUAD}",
+    )
+    # The ceiling (Doom's, 128 units up), facing down; group 2, which top-down maps leave out.
+    ET.SubElement(
+        worldbody, "geom", name="ceiling", type="plane", material="ceiling", group=str(CEILING_GROUP),
+        size=f"{half_extent} {half_extent} {LIT_QUAD}", pos=f"0 0 {WALL_HEIGHT}", euler="180 0 0",
     )
     # An orthographic camera looking straight down at the whole arena, image up
     # = +y, for top-down maps (mjmaze.viz); fovy is then the view's height in metres.
@@ -231,22 +278,27 @@ def _add_textures(root: ET.Element) -> None:
 
 
 def _add_distance_falloff(root: ET.Element) -> None:
-    """A lamp at the agent's eye whose light fades with distance, instead of the headlight.
+    """Light that is brighter near the agent's eye, as Doom's at the released sector light.
 
-    Doom darkens what is far ("light diminishing"); memory-maze and DeepMind
-    Lab shade with distance too. A point light with attenuation is computed at
-    vertices, so it costs next to nothing per pixel (fog, per pixel, cost
-    about twice as much on llvmpipe); the wall mesh is cut into pieces of at
-    most 1 m and the floor is a grid of one-cell quads, so the fall-off is
-    smooth along both. Brightness ~ 1 / (0.7 + 0.3 d): 1 at 1 m, 0.53 at 4 m,
-    0.32 at 8 m, times the angle to the surface.
+    Doom darkens what is far ("light diminishing"); at the sector light the
+    released maps leave at its default (160), ViZDoom draws a ``STONE2`` wall
+    27 + 12 / d grey levels bright ``d`` map cells ahead: a floor of light
+    everywhere and a boost near the eye. Here the headlight gives the floor
+    (ambient only: directional, not attenuated) and a point lamp at the eye the
+    boost (diffuse, attenuated by 1 / (0.05 + d)). Both are computed at vertices,
+    so they cost next to nothing per pixel (fog, per pixel, cost about twice as
+    much on llvmpipe); the wall mesh is cut into pieces of at most 1 m and the
+    floor and ceiling are grids of one-cell quads, so the boost is smooth.
     """
     visual = root.find("visual")
-    visual.find("headlight").set("active", "0")
+    headlight = visual.find("headlight")
+    headlight.set("ambient", f"{AMBIENT} {AMBIENT} {AMBIENT}")
+    headlight.set("diffuse", "0 0 0")
     agent = root.find("worldbody/body[@name='agent']")
     ET.SubElement(
         agent, "light", name=LAMP, pos=f"0 0 {EYE_HEIGHT}", dir="1 0 0", directional="false", castshadow="false",
-        attenuation="0.7 0.3 0", cutoff="180", ambient="0.75 0.75 0.75", diffuse="0.35 0.35 0.35", specular="0 0 0",
+        attenuation=" ".join(map(str, LAMP_ATTENUATION)), cutoff="180", ambient="0 0 0",
+        diffuse=f"{LAMP_DIFFUSE} {LAMP_DIFFUSE} {LAMP_DIFFUSE}", specular="0 0 0",
     )
 
 
@@ -273,13 +325,13 @@ def _brick_texels() -> np.ndarray:
 
 
 def _tile_texels() -> np.ndarray:
-    """Tiles 0.5 m with light grout lines and mottled grain (grey, mean ~1/_TEXTURE_GAIN)."""
+    """Tiles 0.5 m with dark joints and mottled grain (grey, mean ~1/_TEXTURE_GAIN)."""
     n = TEXTURE_TEXELS
     rng = np.random.default_rng(2)
     rows, cols = np.mgrid[0:n, 0:n]
     tile = (rows * 2 // n) * 2 + cols * 2 // n
     grey = rng.uniform(0.6, 0.8, size=4)[tile] * rng.uniform(0.85, 1.0, size=(n, n))
-    grey[(rows % (n // 2) == 0) | (cols % (n // 2) == 0)] = 1.0  # grout
+    grey[(rows % (n // 2) == 0) | (cols % (n // 2) == 0)] = 0.35  # dark joints, as FLAT1_1's
     return _grey_to_rgb(grey)
 
 

@@ -24,9 +24,32 @@ import numpy as np
 BACKENDS = ("egl", "osmesa")
 DEBIAN_PACKAGES = {"egl": "libegl1 libgl1-mesa-dri", "osmesa": "libosmesa6"}
 
-# Geom groups: 0-2 drawn; 3 = collision shapes; 5 = hidden objects.
+# Geom groups: 0-2 drawn (2 = the ceiling, left out of maps); 3 = collision shapes; 5 = hidden objects.
+CEILING_GROUP = 2
 HIDDEN_GROUP = 5
 _VISIBLE_GROUPS = (1, 1, 1, 0, 0, 0)
+
+
+# The pistol the released runs saw over the bottom of the view (their .cfg:
+# render_weapon = true): ViZDoom draws Freedoom's pistol and hand there, ~3% of a
+# 112x64 frame, in front of a floor item right ahead. Drawn as its two parts'
+# boxes, (left, right, top, bottom) as fractions of the frame, in their mean
+# colours as ViZDoom draws them (docs/look.md).
+PISTOL = (
+    ((0.472, 0.541, 0.644, 0.806), (55, 51, 49)),  # the gun
+    ((0.444, 0.569, 0.806, 1.0), (92, 63, 36)),  # the hand holding it
+)
+
+
+def pistol_pixels(width: int, height: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(rows, cols, rgb)`` of the pistol's pixels in a ``height x width`` frame."""
+    rows, cols, colours = [], [], []
+    for (left, right, top, bottom), rgb in PISTOL:
+        r, c = np.mgrid[round(top * height) : round(bottom * height), round(left * width) : round(right * width)]
+        rows.append(r.ravel())
+        cols.append(c.ravel())
+        colours.append(np.tile(np.array(rgb, dtype=np.uint8), (r.size, 1)))
+    return np.concatenate(rows), np.concatenate(cols), np.concatenate(colours)
 
 
 class GLBackendError(RuntimeError):
@@ -187,13 +210,17 @@ class EgoRenderer:
     context (meshes are per model, and the wall mesh is rewritten per maze).
     """
 
-    def __init__(self, model: mujoco.MjModel, camera: str, width: int, height: int, map_view: bool = False):
+    def __init__(
+        self, model: mujoco.MjModel, camera: str, width: int, height: int, map_view: bool = False, pistol: bool = False
+    ):
         """``map_view``: for top-down maps, light the scene evenly from straight
         above instead of with the model's lights (the textured style's lamp sits
         at the agent's eye and fades with distance), and draw no textures, so
-        the floor is one colour under drawn paths."""
+        the floor is one colour under drawn paths. ``pistol``: draw
+        :data:`PISTOL` over each frame (not over :meth:`segmentation`)."""
         gl_context()
         self._map_view = map_view
+        self._pistol = pistol_pixels(width, height) if pistol else None
         model.vis.global_.offwidth = max(model.vis.global_.offwidth, width)
         model.vis.global_.offheight = max(model.vis.global_.offheight, height)
         self._model = model
@@ -210,6 +237,8 @@ class EgoRenderer:
             self._scene.flags[flag] = 0
         self._option = mujoco.MjvOption()
         self._option.geomgroup[:] = _VISIBLE_GROUPS
+        if map_view:  # a top-down map looks through the ceiling
+            self._option.geomgroup[CEILING_GROUP] = 0
         self._option.flags[mujoco.mjtVisFlag.mjVIS_TEXTURE] = not map_view
         self._perturb = mujoco.MjvPerturb()
         self._camera = mujoco.MjvCamera()
@@ -227,7 +256,7 @@ class EgoRenderer:
         """Re-sends a mesh whose vertices changed in the model."""
         mujoco.mjr_uploadMesh(self._model, self._context, mesh_id)
 
-    def render(self, data: mujoco.MjData) -> np.ndarray:
+    def render(self, data: mujoco.MjData, pistol: bool = True) -> np.ndarray:
         """Renders the current state; the result is a view into a reused buffer.
 
         Positions are brought up to date first: after ``mj_step`` they lag
@@ -241,6 +270,9 @@ class EgoRenderer:
         mujoco.mjr_setBuffer(self._offscreen, self._context)
         mujoco.mjr_render(self._viewport, self._scene, self._context)
         mujoco.mjr_readPixels(self._buffer, None, self._viewport, self._context)
+        if self._pistol is not None and pistol:
+            rows, cols, rgb = self._pistol
+            self._frame[rows, cols] = rgb
         return self._frame
 
     def segmentation(self, data: mujoco.MjData) -> np.ndarray:
@@ -249,7 +281,7 @@ class EgoRenderer:
         for flag in flags:
             self._scene.flags[flag] = 1
         try:
-            colours = self.render(data).astype(np.int64)
+            colours = self.render(data, pistol=False).astype(np.int64)
         finally:
             for flag in flags:
                 self._scene.flags[flag] = 0

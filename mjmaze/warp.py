@@ -47,6 +47,7 @@ from gymnasium.vector.utils import batch_space
 import mujoco_warp as mjw
 import warp as wp
 from mjmaze import mjcf, rules, suite
+from mjmaze.render import pistol_pixels
 from mjmaze.tasks import base
 
 # Where a geom that must not be seen or touched in a world goes (below the floor).
@@ -66,7 +67,7 @@ def build_model(task: base.MazeTask) -> tuple[mujoco.MjModel, np.ndarray, np.nda
     absent wall's box below the floor).
     """
     layout = task.layout
-    root = ET.fromstring(mjcf.build_xml(layout.grid_size, layout.cell_size, task.objects, task.visual_style))
+    root = ET.fromstring(mjcf.build_xml(layout.grid_size, layout.cell_size, task.objects, task.visual_style, task.room))
     worldbody, asset = root.find("worldbody"), root.find("asset")
     arena = ET.SubElement(worldbody, "body", name=_ARENA_BODY, mocap="true", pos="0 0 0")
     # One mesh per distinct wall layout among the task's configurations.
@@ -84,7 +85,7 @@ def build_model(task: base.MazeTask) -> tuple[mujoco.MjModel, np.ndarray, np.nda
         name = geom.get("name", "")
         if name == "walls_visual":
             geom.set("mesh", f"{mjcf.WALL_MESH}_0")
-        elif name == "floor":  # the one geom that stays in the world body
+        elif name in ("floor", "ceiling"):  # the geoms that stay in the world body
             continue
         worldbody.remove(geom)
         arena.append(geom)
@@ -230,6 +231,11 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         self._geom_rgba = wp.to_torch(self._model.geom_rgba)
         self._geom_dataid = wp.to_torch(self._model.geom_dataid)
         self._rgb_packed = wp.to_torch(self._render.rgb_data)
+        # The pistol over each frame, as the CPU renderer draws it (mjmaze.render.PISTOL).
+        self._pistol = None
+        if task.visual_style == "textured":
+            rows, cols, rgb = pistol_pixels(width, height)
+            self._pistol = tuple(torch.as_tensor(a, device=dev) for a in (rows, cols, rgb))
         self._stream = wp.stream_from_torch(torch.cuda.current_stream(dev)) if dev.type == "cuda" else None
 
         self._seed_keys = torch.zeros(n, dtype=torch.int64, device=dev)
@@ -378,6 +384,9 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         # Packed 0xAABBGGRR per pixel: bytes R, G, B, A in memory.
         packed = self._rgb_packed.view(torch.uint8).view(self.num_envs, self.task.height, self.task.width, 4)
         self._obs.copy_(packed[..., [2, 1, 0]])
+        if self._pistol is not None:
+            rows, cols, rgb = self._pistol
+            self._obs[:, rows, cols] = rgb
 
     def segmentation(self) -> torch.Tensor:
         """``(N, H, W)`` geom id drawn at each pixel of the last frames, -1 for none (needs ``render_segmentation``)."""

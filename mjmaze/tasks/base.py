@@ -174,6 +174,8 @@ class MazeTask(base.Task):
     objects: Sequence[mjcf.ObjectGeom] = ()
     #: The scenario's name, as passed to ``mjmaze.load`` (it also enters the maze seeds).
     scenario: str = ""
+    #: The colours of its walls, floor and ceiling (the released Doom textures').
+    room: mjcf.Room = mjcf.STONE_ROOM
 
     def __init__(
         self,
@@ -249,7 +251,10 @@ class MazeTask(base.Task):
         self._model, self._bound_data = model, data
         self._qpos, self._qvel = data.qpos, data.qvel
         self._walls = mjcf.WallLayout(model, self.layout.grid_size, self.layout.cell_size)
-        self._renderer = render.EgoRenderer(model, CAMERA, self.width, self.height)
+        # The pistol belongs to the paper's look ("textured"), not to the cheap "flat" one.
+        self._renderer = render.EgoRenderer(
+            model, CAMERA, self.width, self.height, pistol=self.visual_style == "textured"
+        )
         fovy = math.radians(model.cam(CAMERA).fovy[0])
         self.horizontal_fov = 2 * math.atan(math.tan(fovy / 2) * self.width / self.height)
         self._config_in_model = None
@@ -505,7 +510,7 @@ def tic_motion(xp, vx, vy, yaw, forward, turn, turn_held, timestep: float):
 
 def make_environment(task: MazeTask, environment_kwargs: dict | None = None) -> control.Environment:
     """Compiles the task's arena and wraps it in a dm_control environment."""
-    xml = mjcf.build_xml(task.layout.grid_size, task.layout.cell_size, task.objects, task.visual_style)
+    xml = mjcf.build_xml(task.layout.grid_size, task.layout.cell_size, task.objects, task.visual_style, task.room)
     physics = MazePhysics.from_xml_string(xml)
     mjcf.paint_textures(physics.model.ptr)
     kwargs = dict(n_sub_steps=TICS_PER_STEP, legacy_step=False)

@@ -38,10 +38,12 @@ PILLAR_HEIGHT = 52 * base.MAP_UNIT
 SPAWN_OFFSET = 0.25
 
 GREEN_PILLAR = mjcf.ObjectGeom(
-    "green_pillar", "cylinder", (PILLAR_RADIUS, PILLAR_HEIGHT / 2), (0.1, 0.8, 0.1, 1.0), PILLAR_HEIGHT / 2, collides=True
+    "green_pillar", "cylinder", (PILLAR_RADIUS, PILLAR_HEIGHT / 2), mjcf.TALL_GREEN_COLUMN_RGBA, PILLAR_HEIGHT / 2,
+    collides=True,
 )
 RED_PILLAR = mjcf.ObjectGeom(
-    "red_pillar", "cylinder", (PILLAR_RADIUS, PILLAR_HEIGHT / 2), (0.9, 0.1, 0.1, 1.0), PILLAR_HEIGHT / 2, collides=True
+    "red_pillar", "cylinder", (PILLAR_RADIUS, PILLAR_HEIGHT / 2), mjcf.TALL_RED_COLUMN_RGBA, PILLAR_HEIGHT / 2,
+    collides=True,
 )
 
 

@@ -33,8 +33,10 @@ STEP_REWARD = -0.0001 * base.TICS_PER_STEP
 # on the floor, 40 x 16 map units (a 31 x 17 sprite), i.e. 0.12 m in radius and
 # 0.125 m high. A cylinder shows the same width from every side, as a sprite.
 # How small it is decides how far off the agent can spot it (docs/objects.md).
+# Its colour is the armour's as ViZDoom draws it, blinking, at the released
+# light: a dull olive, little brighter than the walls (docs/look.md).
 EXIT_RADIUS, EXIT_HEIGHT = 0.12, 16 * base.MAP_UNIT
-EXIT = mjcf.ObjectGeom("exit", "cylinder", (EXIT_RADIUS, EXIT_HEIGHT / 2), (0.15, 0.65, 0.15, 1.0), z=EXIT_HEIGHT / 2)
+EXIT = mjcf.ObjectGeom("exit", "cylinder", (EXIT_RADIUS, EXIT_HEIGHT / 2), (0.52, 0.63, 0.39, 1.0), z=EXIT_HEIGHT / 2)
 
 
 class Labyrinth(base.MazeTask):

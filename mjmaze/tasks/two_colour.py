@@ -65,14 +65,19 @@ _NEVER = 1 << 40
 # Elements per array in the item draws' wall test (bounds memory for big batches).
 _CHUNK_ELEMENTS = 1 << 24
 
-RED, GREEN = (0.9, 0.1, 0.1, 1.0), (0.1, 0.8, 0.1, 1.0)
+# Colours as ViZDoom draws the released things (docs/look.md): the totem is
+# Doom's tall red or green column (things 32 / 30), the items Freedoom's green
+# armour and its "blue" armour, which Freedoom draws red (the released ACS calls
+# it the red armour).
+RED, GREEN = mjcf.TALL_RED_COLUMN_RGBA, mjcf.TALL_GREEN_COLUMN_RGBA
+ITEM_RED, ITEM_GREEN = (0.59, 0.25, 0.24, 1.0), (0.42, 0.53, 0.33, 1.0)
 TOTEM_RADIUS, TOTEM_HEIGHT = 0.125, 1.0
 TOTEM = mjcf.ObjectGeom("totem", "cylinder", (TOTEM_RADIUS, TOTEM_HEIGHT / 2), RED, TOTEM_HEIGHT / 2, collides=True)
 # The agent's centre never comes closer to the totem's than this.
 TOTEM_CLEARANCE = TOTEM_RADIUS + base.AGENT_RADIUS
 ITEM_HALF = 0.09
 ITEMS = tuple(
-    mjcf.ObjectGeom(f"item_{k}", "box", (ITEM_HALF, ITEM_HALF, ITEM_HALF), RED, ITEM_HALF) for k in range(POOL_SIZE)
+    mjcf.ObjectGeom(f"item_{k}", "box", (ITEM_HALF, ITEM_HALF, ITEM_HALF), ITEM_RED, ITEM_HALF) for k in range(POOL_SIZE)
 )
 
 
@@ -80,6 +85,7 @@ class TwoColour(base.MazeTask):
     """Pick up items of the totem's colour to stay alive; see the module docstring."""
 
     scenario = "two_colour"
+    room = mjcf.SLIME_ROOM
     objects = (TOTEM, *ITEMS)
 
     def __init__(
@@ -117,8 +123,11 @@ class TwoColour(base.MazeTask):
         spawn_xy = config["spawn_xy"]
         totem_green = rules.uniform(xp, keys, rules.DRAW_COLOUR) < 0.5
         rgba = xp.asarray(np.array([RED, GREEN]), device=device)
+        item_colours = xp.asarray(np.array([ITEM_RED, ITEM_GREEN]), device=device)
         # Items alternate colours, green first; the totem's is drawn per episode.
-        item_rgba = xp.broadcast_to(rgba[xp.asarray(1 - np.arange(POOL_SIZE) % 2, device=device)], (batch, POOL_SIZE, 4))
+        item_rgba = xp.broadcast_to(
+            item_colours[xp.asarray(1 - np.arange(POOL_SIZE) % 2, device=device)], (batch, POOL_SIZE, 4)
+        )
         inside_totem = xp.sum((spawn_xy - totem_xy) ** 2, axis=1) < TOTEM_CLEARANCE**2
         state = {
             "pose": xp.concat([spawn_xy, xp.zeros((batch, 1), dtype=xp.float64, device=device)], axis=1),

@@ -1,0 +1,142 @@
+"""The frames look as ViZDoom draws the released maps (docs/look.md).
+
+The expected colours were measured in ViZDoom with ``python docs/doom_frames.py
+--calibrate`` (same map, same pose, 112x64 after the released area resize);
+these tests hold them, so they run without ViZDoom.
+"""
+
+import numpy as np
+import pytest
+
+import mjmaze
+from mjmaze import mjcf, render, viz
+from mjmaze.tasks import base, find_return, labyrinth, two_colour
+
+from conftest import find_cell, open_run, place
+
+# Mean colour tolerance per channel, in grey levels (0-255).
+CLOSE = 9
+
+
+def empty_room(room: mjcf.Room):
+    """A 10 m arena without walls inside (Two-colour at complexity 0) coloured as ``room``, objects hidden."""
+    task = two_colour.TwoColour(complexity=0, item_cap=0, random=0)
+    task.room = room
+    env = base.make_environment(task)
+    env.reset()
+    env.physics.show_objects(env.physics.object_ids([o.name for o in task.objects])[1], False)
+    return env
+
+
+def frame_at(env, x, y, yaw):
+    place(env, x, y, yaw)
+    return env.task.get_observation(env.physics)["pixels"].astype(float)
+
+
+def wall_grey(env, distance):
+    """Mean of the frame's centre facing the +x outer wall from ``distance`` m."""
+    face = env.task.config.size * env.task.config.cell_size / 2 - mjcf.WALL_THICKNESS / 2
+    return frame_at(env, face - distance, 0.0, 0.0)[24:32, 50:62].mean()
+
+
+def test_walls_are_as_dim_as_vizdooms_and_brighter_near_the_eye():
+    env = empty_room(mjcf.STONE_ROOM)
+    # ViZDoom, a STONE2 wall at sector light 160: 49, 38, 34, 30 grey at 0.5, 1, 2, 4 m.
+    greys = [wall_grey(env, d) for d in (0.5, 1.0, 2.0, 4.0)]
+    for got, doom in zip(greys, (49, 38, 34, 30)):
+        assert got == pytest.approx(doom, abs=CLOSE)
+    assert greys[0] > greys[1] > greys[3]  # the depth cue: light diminishing
+    env.task.close()
+
+
+@pytest.mark.parametrize("room, floor, ceiling", [
+    (mjcf.STONE_ROOM, (48, 35, 18), (34, 34, 34)),  # FLAT1_1 brown, MFLR8_1 grey
+    (mjcf.SLIME_ROOM, (18, 35, 10), (0, 0, 17)),  # NUKAGE1 green, CEIL4_1 dark blue
+])
+def test_floor_and_ceiling_have_vizdooms_colours(room, floor, ceiling):
+    env = empty_room(room)
+    frame = frame_at(env, 0.0, 0.0, 0.0)
+    assert frame[40:64, 0:40].reshape(-1, 3).mean(axis=0) == pytest.approx(floor, abs=CLOSE)
+    assert frame[0:6, 30:82].reshape(-1, 3).mean(axis=0) == pytest.approx(ceiling, abs=CLOSE)
+    env.task.close()
+
+
+def object_colour(env, name, pose):
+    """Mean colour where object ``name`` is drawn, seen from ``pose``, outside the pistol."""
+    frame = frame_at(env, *pose)
+    mask = np.isin(env.task.segmentation(env.physics), env.physics.object_ids([name])[1])
+    rows, cols, _ = render.pistol_pixels(frame.shape[1], frame.shape[0])
+    mask[rows, cols] = False
+    assert mask.sum() >= 10
+    return frame[mask].mean(axis=0)
+
+
+def test_the_labyrinth_exit_is_the_green_armours_dull_olive_not_a_bright_green():
+    env = mjmaze.load("labyrinth", task_kwargs={"size": 5, "random": 0})
+    env.reset()
+    config, physics = env.task.config, env.physics
+    cell = find_cell(config, lambda c: open_run(config, c, 2))
+    x, y = config.cell_centre(cell)
+    exit_ids = physics.object_ids([labyrinth.EXIT.name])
+    physics.place_objects(exit_ids[0], np.array([[x + 2.0, y]]))  # 2 cells straight ahead
+    colour = object_colour(env, labyrinth.EXIT.name, (x, y, 0.0))
+    # ViZDoom: the green armour 2 cells ahead, averaged over its blink: (49, 59, 37).
+    assert colour == pytest.approx((49, 59, 37), abs=CLOSE)
+    assert colour[1] - colour[0] < 20  # olive: green barely above red
+    env.task.close()
+
+
+@pytest.mark.parametrize("name, rgba, doom", [
+    (two_colour.TOTEM.name, two_colour.GREEN, (24, 48, 17)),  # tall green column
+    (two_colour.TOTEM.name, two_colour.RED, (69, 6, 4)),  # tall red column
+    (two_colour.ITEMS[0].name, two_colour.ITEM_GREEN, (46, 58, 36)),  # green armour
+    (two_colour.ITEMS[0].name, two_colour.ITEM_RED, (65, 28, 26)),  # Freedoom's "blue" armour, red
+])
+def test_two_colour_objects_2m_ahead_have_vizdooms_colours(name, rgba, doom):
+    env = empty_room(mjcf.SLIME_ROOM)
+    physics = env.physics
+    ids = physics.object_ids([name])
+    physics.set_object_rgba(ids[1][0], rgba)
+    physics.show_objects(ids[1], True)
+    physics.place_objects(ids[0], np.array([[2.0, 0.0]]))
+    assert object_colour(env, name, (0.0, 0.0, 0.0)) == pytest.approx(doom, abs=CLOSE)
+    env.task.close()
+
+
+def test_find_return_pillars_are_doom_columns():
+    assert find_return.RED_PILLAR.rgba == mjcf.TALL_RED_COLUMN_RGBA == two_colour.RED
+    assert find_return.GREEN_PILLAR.rgba == mjcf.TALL_GREEN_COLUMN_RGBA == two_colour.GREEN
+
+
+def test_the_pistol_hides_a_floor_item_right_ahead():
+    env = mjmaze.load("labyrinth", task_kwargs={"size": 5, "random": 0})
+    env.reset()
+    physics = env.physics
+    exit_ids = physics.object_ids([labyrinth.EXIT.name])
+    physics.place_objects(exit_ids[0], np.array([[0.6, 0.0]]))
+    frame = frame_at(env, 0.0, 0.0, 0.0)
+    seg = env.task.segmentation(physics)
+    rows, cols, rgb = render.pistol_pixels(frame.shape[1], frame.shape[0])
+    assert (frame[rows, cols] == rgb).all()  # drawn over the view
+    hidden = np.isin(seg[rows, cols], exit_ids[1]).sum()
+    assert hidden >= 10  # the exit is there, behind the pistol
+    env.task.close()
+
+
+def test_the_flat_style_draws_no_pistol_and_maps_no_ceiling():
+    env = mjmaze.load("labyrinth", task_kwargs={"size": 5, "random": 0, "visual_style": "flat"})
+    env.reset()
+    frame = env.task.get_observation(env.physics)["pixels"]
+    rows, cols, rgb = render.pistol_pixels(frame.shape[1], frame.shape[0])
+    assert not (frame[rows, cols] == rgb).all(axis=1).any()
+    env.task.close()
+
+    env = mjmaze.load("labyrinth", task_kwargs={"size": 5, "random": 0})
+    env.reset()
+    top_down = viz.TopDown(env, 100)
+    image = top_down.render().reshape(-1, 3).astype(float)
+    # Seen from above: the brown floor (red over blue), not the grey ceiling over everything.
+    floor = image[(image[:, 0] > image[:, 2] + 20)]
+    assert len(floor) > 0.3 * len(image)
+    top_down.close()
+    env.task.close()
