@@ -33,12 +33,13 @@ VISUAL_STYLES = ("textured", "flat")
 
 @dataclasses.dataclass(frozen=True)
 class Room:
-    """The mean colours (0-1) of a scenario's walls, floor and ceiling.
+    """The colours (0-1) of a scenario's walls, floor and ceiling.
 
-    They are the released scenario's Doom textures as ViZDoom draws them at
-    the released sector light (160), divided by the lamp's brightness
-    (:func:`_add_distance_falloff`): ``python docs/doom_frames.py --calibrate``
-    prints ViZDoom's colours beside mjmaze's (docs/look.md).
+    They make mjmaze's frames show the mean colours of the released scenario's
+    Doom textures as ViZDoom draws them at the released sector light (160):
+    walls and floor are lit (:func:`_add_distance_falloff`), the ceiling is
+    seen in its colour as is. ``python docs/doom_frames.py --calibrate`` prints
+    ViZDoom's colours beside mjmaze's (docs/look.md).
     """
 
     wall: tuple[float, float, float]
@@ -48,9 +49,9 @@ class Room:
 
 #: Labyrinth, Find-and-return and K-item: ``STONE2`` walls (grey), ``FLAT1_1``
 #: floor (brown), ``MFLR8_1`` ceiling (grey), as the released generators write them.
-STONE_ROOM = Room(wall=(0.33, 0.33, 0.33), floor=(0.52, 0.40, 0.19), ceiling=(0.34, 0.34, 0.34))
+STONE_ROOM = Room(wall=(0.33, 0.33, 0.33), floor=(0.52, 0.40, 0.19), ceiling=(0.133, 0.133, 0.133))
 #: Two-colour: ``GSTONE1`` walls (green-grey), ``NUKAGE1`` floor (green slime), ``CEIL4_1`` ceiling.
-SLIME_ROOM = Room(wall=(0.39, 0.42, 0.28), floor=(0.20, 0.40, 0.13), ceiling=(0.0, 0.0, 0.20))
+SLIME_ROOM = Room(wall=(0.39, 0.42, 0.28), floor=(0.20, 0.40, 0.13), ceiling=(0.0, 0.0, 0.067))
 #: Doom's tall green and red columns (things 30, 32: Find-and-return's pillars,
 #: Two-colour's totem) as ViZDoom draws them, on a cylinder of their radius.
 TALL_GREEN_COLUMN_RGBA = (0.24, 0.51, 0.17, 1.0)
@@ -61,7 +62,7 @@ TALL_RED_COLUMN_RGBA = (0.73, 0.06, 0.04, 1.0)
 AMBIENT = 0.28
 LAMP_DIFFUSE = 0.30
 LAMP_ATTENUATION = (0.05, 1.0, 0.0)
-#: Side of the floor's and ceiling's quads: lighting is computed at their
+#: Side of the floor's quads: lighting is computed at their
 #: corners. With 1 m quads the floor under the eye flashed 2.5x brighter each
 #: time the agent passed a corner; 0.5 m keeps it within ~15% and costs ~3% of a
 #: frame on llvmpipe (0.25 m: 30%).
@@ -76,6 +77,7 @@ OVERHEAD_CAMERA = "overhead"
 OVERHEAD_HEIGHT = 10.0
 LAMP = "lamp"
 CEILING_GROUP = 2
+CEILING_HALF_THICKNESS = 0.01
 EYE_HEIGHT = 0.32  # the ego camera's height (xml_templates/arena.xml)
 
 # Per wall box in the visual mesh: 4 side faces + the top (the bottom is never
@@ -152,9 +154,15 @@ def build_xml(
     root = ET.fromstring(template_path().read_text())
     worldbody = root.find("worldbody")
     asset = root.find("asset")
-    for name in ("wall", "floor", "ceiling"):
+    for name in ("wall", "floor"):
         ET.SubElement(asset, "material", name=name, rgba=" ".join(f"{v:.3f}" for v in getattr(room, name)) + " 1",
                       specular="0", shininess="0", reflectance="0")
+    # The ceiling shows its colour whatever the light: it glows (emission) with
+    # a dim base colour, so the lights add almost nothing (under 5%) and its few
+    # far-apart vertices cannot make it flash.
+    glow = 10.0
+    ET.SubElement(asset, "material", name="ceiling", rgba=" ".join(f"{v / glow:.4f}" for v in room.ceiling) + " 1",
+                  emission=f"{glow - AMBIENT}", specular="0", shininess="0", reflectance="0")
     if visual_style == "textured":
         _add_textures(root)
     segments = wall_segments(grid_size, cell_size)
@@ -172,10 +180,12 @@ def build_xml(
         worldbody, "geom", name="floor", type="plane", material="floor",
         size=f"{half_extent} {half_extent} {LIT_QUAD}",
     )
-    # The ceiling (Doom's, 128 units up), facing down; group 2, which top-down maps leave out.
+    # The ceiling, Doom's 128 units up: a thin box (one quad per face), group 2,
+    # which top-down maps leave out. A lit plane grid like the floor's cost
+    # llvmpipe 48 us a frame, this 18 (bench numbers in docs/look.md).
     ET.SubElement(
-        worldbody, "geom", name="ceiling", type="plane", material="ceiling", group=str(CEILING_GROUP),
-        size=f"{half_extent} {half_extent} {LIT_QUAD}", pos=f"0 0 {WALL_HEIGHT}", euler="180 0 0",
+        worldbody, "geom", name="ceiling", type="box", material="ceiling", group=str(CEILING_GROUP),
+        size=f"{half_extent} {half_extent} {CEILING_HALF_THICKNESS}", pos=f"0 0 {WALL_HEIGHT + CEILING_HALF_THICKNESS}",
     )
     # An orthographic camera looking straight down at the whole arena, image up
     # = +y, for top-down maps (mjmaze.viz); fovy is then the view's height in metres.

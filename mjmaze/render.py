@@ -41,14 +41,23 @@ PISTOL = (
 )
 
 
+def pistol_boxes(width: int, height: int) -> list[tuple[slice, slice, np.ndarray]]:
+    """``[(rows, cols, rgb)]``: the pistol's parts as slices of a ``height x width`` frame."""
+    return [
+        (slice(round(top * height), round(bottom * height)), slice(round(left * width), round(right * width)),
+         np.array(rgb, dtype=np.uint8))
+        for (left, right, top, bottom), rgb in PISTOL
+    ]
+
+
 def pistol_pixels(width: int, height: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(rows, cols, rgb)`` of the pistol's pixels in a ``height x width`` frame."""
+    """``(rows, cols, rgb)`` of each of the pistol's pixels (for masks in tests and docs)."""
     rows, cols, colours = [], [], []
-    for (left, right, top, bottom), rgb in PISTOL:
-        r, c = np.mgrid[round(top * height) : round(bottom * height), round(left * width) : round(right * width)]
-        rows.append(r.ravel())
-        cols.append(c.ravel())
-        colours.append(np.tile(np.array(rgb, dtype=np.uint8), (r.size, 1)))
+    for r, c, rgb in pistol_boxes(width, height):
+        grid_r, grid_c = np.mgrid[r, c]
+        rows.append(grid_r.ravel())
+        cols.append(grid_c.ravel())
+        colours.append(np.tile(rgb, (grid_r.size, 1)))
     return np.concatenate(rows), np.concatenate(cols), np.concatenate(colours)
 
 
@@ -220,7 +229,7 @@ class EgoRenderer:
         :data:`PISTOL` over each frame (not over :meth:`segmentation`)."""
         gl_context()
         self._map_view = map_view
-        self._pistol = pistol_pixels(width, height) if pistol else None
+        self._pistol = pistol_boxes(width, height) if pistol else []
         model.vis.global_.offwidth = max(model.vis.global_.offwidth, width)
         model.vis.global_.offheight = max(model.vis.global_.offheight, height)
         self._model = model
@@ -270,8 +279,7 @@ class EgoRenderer:
         mujoco.mjr_setBuffer(self._offscreen, self._context)
         mujoco.mjr_render(self._viewport, self._scene, self._context)
         mujoco.mjr_readPixels(self._buffer, None, self._viewport, self._context)
-        if self._pistol is not None and pistol:
-            rows, cols, rgb = self._pistol
+        for rows, cols, rgb in self._pistol if pistol else ():
             self._frame[rows, cols] = rgb
         return self._frame
 

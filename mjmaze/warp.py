@@ -47,7 +47,7 @@ from gymnasium.vector.utils import batch_space
 import mujoco_warp as mjw
 import warp as wp
 from mjmaze import mjcf, rules, suite
-from mjmaze.render import pistol_pixels
+from mjmaze.render import pistol_boxes
 from mjmaze.tasks import base
 
 # Where a geom that must not be seen or touched in a world goes (below the floor).
@@ -232,10 +232,10 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         self._geom_dataid = wp.to_torch(self._model.geom_dataid)
         self._rgb_packed = wp.to_torch(self._render.rgb_data)
         # The pistol over each frame, as the CPU renderer draws it (mjmaze.render.PISTOL).
-        self._pistol = None
-        if task.visual_style == "textured":
-            rows, cols, rgb = pistol_pixels(width, height)
-            self._pistol = tuple(torch.as_tensor(a, device=dev) for a in (rows, cols, rgb))
+        self._pistol = [
+            (rows, cols, torch.as_tensor(rgb, device=dev))
+            for rows, cols, rgb in (pistol_boxes(width, height) if task.visual_style == "textured" else [])
+        ]
         self._stream = wp.stream_from_torch(torch.cuda.current_stream(dev)) if dev.type == "cuda" else None
 
         self._seed_keys = torch.zeros(n, dtype=torch.int64, device=dev)
@@ -384,8 +384,7 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         # Packed 0xAABBGGRR per pixel: bytes R, G, B, A in memory.
         packed = self._rgb_packed.view(torch.uint8).view(self.num_envs, self.task.height, self.task.width, 4)
         self._obs.copy_(packed[..., [2, 1, 0]])
-        if self._pistol is not None:
-            rows, cols, rgb = self._pistol
+        for rows, cols, rgb in self._pistol:
             self._obs[:, rows, cols] = rgb
 
     def segmentation(self) -> torch.Tensor:
