@@ -64,8 +64,8 @@ LAMP_DIFFUSE = 0.30
 LAMP_ATTENUATION = (0.05, 1.0, 0.0)
 #: Side of the floor's quads: lighting is computed at their
 #: corners. With 1 m quads the floor under the eye flashed 2.5x brighter each
-#: time the agent passed a corner; 0.5 m keeps it within ~15% and costs ~3% of a
-#: frame on llvmpipe (0.25 m: 30%).
+#: time the agent passed a corner; 0.5 m keeps it within ~15% and costs ~30 us
+#: (~10%) of a frame on llvmpipe (0.25 m: twice that again).
 LIT_QUAD = 0.5
 TEXTURE_TEXELS = 64  # per side of a texture; one texture covers 1 m x 1 m
 # 1 / the mean grey of each texture (see _brick_texels, _tile_texels).
@@ -76,7 +76,7 @@ WALL_MESH = "walls"
 OVERHEAD_CAMERA = "overhead"
 OVERHEAD_HEIGHT = 10.0
 LAMP = "lamp"
-CEILING_GROUP = 2
+CEILING_GROUP = 2  # a geom group drawn in the agent's view, left out of top-down maps (mjmaze.render)
 CEILING_HALF_THICKNESS = 0.01
 EYE_HEIGHT = 0.32  # the ego camera's height (xml_templates/arena.xml)
 
@@ -182,7 +182,7 @@ def build_xml(
     )
     # The ceiling, Doom's 128 units up: a thin box (one quad per face), group 2,
     # which top-down maps leave out. A lit plane grid like the floor's cost
-    # llvmpipe 48 us a frame, this 18 (bench numbers in docs/look.md).
+    # llvmpipe 48 us a frame, this 18 (README, "Speed").
     ET.SubElement(
         worldbody, "geom", name="ceiling", type="box", material="ceiling", group=str(CEILING_GROUP),
         size=f"{half_extent} {half_extent} {CEILING_HALF_THICKNESS}", pos=f"0 0 {WALL_HEIGHT + CEILING_HALF_THICKNESS}",
@@ -298,7 +298,7 @@ def _add_distance_falloff(root: ET.Element) -> None:
     boost (diffuse, attenuated by 1 / (0.05 + d)). Both are computed at vertices,
     so they cost next to nothing per pixel (fog, per pixel, cost about twice as
     much on llvmpipe); the wall mesh is cut into pieces of at most 1 m and the
-    floor and ceiling are grids of one-cell quads, so the boost is smooth.
+    floor is a grid of :data:`LIT_QUAD` quads, so the boost is smooth.
     """
     visual = root.find("visual")
     headlight = visual.find("headlight")

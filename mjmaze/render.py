@@ -21,11 +21,12 @@ import sys
 import mujoco
 import numpy as np
 
+from mjmaze import mjcf
+
 BACKENDS = ("egl", "osmesa")
 DEBIAN_PACKAGES = {"egl": "libegl1 libgl1-mesa-dri", "osmesa": "libosmesa6"}
 
-# Geom groups: 0-2 drawn (2 = the ceiling, left out of maps); 3 = collision shapes; 5 = hidden objects.
-CEILING_GROUP = 2
+# Geom groups: 0-2 drawn (mjcf.CEILING_GROUP, 2, left out of maps); 3 = collision shapes; 5 = hidden objects.
 HIDDEN_GROUP = 5
 _VISIBLE_GROUPS = (1, 1, 1, 0, 0, 0)
 
@@ -247,7 +248,7 @@ class EgoRenderer:
         self._option = mujoco.MjvOption()
         self._option.geomgroup[:] = _VISIBLE_GROUPS
         if map_view:  # a top-down map looks through the ceiling
-            self._option.geomgroup[CEILING_GROUP] = 0
+            self._option.geomgroup[mjcf.CEILING_GROUP] = 0
         self._option.flags[mujoco.mjtVisFlag.mjVIS_TEXTURE] = not map_view
         self._perturb = mujoco.MjvPerturb()
         self._camera = mujoco.MjvCamera()
