@@ -56,6 +56,11 @@ SLIME_ROOM = Room(wall=(0.39, 0.42, 0.28), floor=(0.20, 0.40, 0.13), ceiling=(0.
 #: Two-colour's totem) as ViZDoom draws them, on a cylinder of their radius.
 TALL_GREEN_COLUMN_RGBA = (0.24, 0.51, 0.17, 1.0)
 TALL_RED_COLUMN_RGBA = (0.73, 0.06, 0.04, 1.0)
+#: Freedoom's green armour (thing 2018: the Labyrinth exit, Two-colour's green
+#: items) and its "blue" armour (2019), which Freedoom draws red (Two-colour's
+#: red items), averaged over their blink, on a floor cylinder of their size.
+GREEN_ARMOUR_RGBA = (0.52, 0.63, 0.39, 1.0)
+RED_ARMOUR_RGBA = (0.73, 0.31, 0.30, 1.0)
 #: Ambient light everywhere, then a lamp at the eye adding ``LAMP_DIFFUSE x cos / (0.05 + d)``
 #: at ``d`` metres: Doom's light diminishing at sector light 160, which ViZDoom
 #: draws as 27 + 12 / d grey levels on a ``STONE2`` wall ``d`` map cells ahead.
@@ -67,6 +72,7 @@ LAMP_ATTENUATION = (0.05, 1.0, 0.0)
 #: time the agent passed a corner; 0.5 m keeps it within ~15% and costs ~30 us
 #: (~10%) of a frame on llvmpipe (0.25 m: twice that again).
 LIT_QUAD = 0.5
+MAP_UNIT = 1 / 128  # metres per Doom map unit (a 128-unit cell is 1 m)
 TEXTURE_TEXELS = 64  # per side of a texture; one texture covers 1 m x 1 m
 # 1 / the mean grey of each texture (see _brick_texels, _tile_texels).
 _TEXTURE_GAIN = {"wall": 1.35, "floor": 1.6}
@@ -107,6 +113,18 @@ class ObjectGeom:
     rgba: tuple[float, float, float, float]
     z: float
     collides: bool = False
+
+
+def floor_thing(name: str, shape: str, width: float, height: float, rgba, collides: bool = False) -> ObjectGeom:
+    """A Doom thing on the floor, ``width`` x ``height`` map units (its sprite's size), as an object geom.
+
+    A sprite always faces the camera; a cylinder (``shape="cylinder"``, or a
+    ``"sphere"`` of diameter ``width``) shows the same width from every side.
+    """
+    radius, height = width / 2 * MAP_UNIT, height * MAP_UNIT
+    if shape == "sphere":
+        return ObjectGeom(name, "sphere", (radius,), rgba, radius, collides)
+    return ObjectGeom(name, "cylinder", (radius, height / 2), rgba, height / 2, collides)
 
 
 def template_path(name: str = "arena.xml"):

@@ -38,7 +38,7 @@ EPISODE_STEPS = 525  # 2100 tics
 # it after the tic's move, so the agent gathers speed over ~3 agent steps and
 # coasts after letting go; a turn key turns 3.52 degrees a tic, half that for
 # the first 5 tics it is held.
-MAP_UNIT = 1 / 128  # metres
+MAP_UNIT = mjcf.MAP_UNIT  # metres
 THRUST_PER_TIC = 25 * 2048 / 65536 * MAP_UNIT  # m/tic gained per tic: forwardmove 0x19 (walking)
 FRICTION = 0xE800 / 0x10000  # share of the velocity a tic keeps
 TURN_PER_TIC = math.tau * 640 / 65536  # radians: angleturn 640 of a 65536 turn

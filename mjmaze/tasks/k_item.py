@@ -39,28 +39,20 @@ WRONG_ITEM_REWARD = -0.25
 STEP_REWARD = -0.0001 * base.TICS_PER_STEP
 
 
-def _floor_item(name: str, shape: str, width: float, height: float, rgba) -> mjcf.ObjectGeom:
-    """An item lying on the floor, ``width`` x ``height`` map units as its Doom sprite."""
-    radius, height = width / 2 * base.MAP_UNIT, height * base.MAP_UNIT
-    if shape == "sphere":
-        return mjcf.ObjectGeom(name, "sphere", (radius,), rgba, radius)
-    return mjcf.ObjectGeom(name, "cylinder", (radius, height / 2), rgba, height / 2)
-
-
 # Item kinds in collection order: (colour code in the released files, geom).
 # Sizes are those of the things the released generators place, in this order
 # (docs/objects.md): green armour 2018, blue armour 2019, medikit 2012,
 # soulsphere 2013, red and blue keycards 13 and 5; colours are the spec's.
 # The two greys (K = 8) are not in the released files we have: our shapes.
 KINDS = (
-    ("g", _floor_item("item_green", "cylinder", 31, 17, (0.1, 0.85, 0.1, 1.0))),
-    ("r", _floor_item("item_red", "cylinder", 31, 17, (0.95, 0.1, 0.1, 1.0))),
-    ("b", _floor_item("item_blue", "cylinder", 28, 19, (0.15, 0.25, 1.0, 1.0))),
-    ("c", _floor_item("item_cyan", "sphere", 24, 24, (0.0, 0.9, 0.9, 1.0))),
-    ("m", _floor_item("item_magenta", "cylinder", 14, 16, (0.9, 0.1, 0.9, 1.0))),
-    ("y", _floor_item("item_yellow", "cylinder", 14, 16, (1.0, 0.9, 0.0, 1.0))),
-    ("0.5", _floor_item("item_grey50", "sphere", 31, 31, (0.5, 0.5, 0.5, 1.0))),
-    ("0.75", _floor_item("item_grey75", "cylinder", 18, 41, (0.75, 0.75, 0.75, 1.0))),
+    ("g", mjcf.floor_thing("item_green", "cylinder", 31, 17, (0.1, 0.85, 0.1, 1.0))),
+    ("r", mjcf.floor_thing("item_red", "cylinder", 31, 17, (0.95, 0.1, 0.1, 1.0))),
+    ("b", mjcf.floor_thing("item_blue", "cylinder", 28, 19, (0.15, 0.25, 1.0, 1.0))),
+    ("c", mjcf.floor_thing("item_cyan", "sphere", 24, 24, (0.0, 0.9, 0.9, 1.0))),
+    ("m", mjcf.floor_thing("item_magenta", "cylinder", 14, 16, (0.9, 0.1, 0.9, 1.0))),
+    ("y", mjcf.floor_thing("item_yellow", "cylinder", 14, 16, (1.0, 0.9, 0.0, 1.0))),
+    ("0.5", mjcf.floor_thing("item_grey50", "sphere", 31, 31, (0.5, 0.5, 0.5, 1.0))),
+    ("0.75", mjcf.floor_thing("item_grey75", "cylinder", 18, 41, (0.75, 0.75, 0.75, 1.0))),
 )
 KIND_OF_CODE = {code: kind for kind, (code, _) in enumerate(KINDS)}
 

@@ -36,7 +36,7 @@ STEP_REWARD = -0.0001 * base.TICS_PER_STEP
 # Its colour is the armour's as ViZDoom draws it, blinking, at the released
 # light: a dull olive, little brighter than the walls (docs/look.md).
 EXIT_RADIUS, EXIT_HEIGHT = 0.12, 16 * base.MAP_UNIT
-EXIT = mjcf.ObjectGeom("exit", "cylinder", (EXIT_RADIUS, EXIT_HEIGHT / 2), (0.52, 0.63, 0.39, 1.0), z=EXIT_HEIGHT / 2)
+EXIT = mjcf.ObjectGeom("exit", "cylinder", (EXIT_RADIUS, EXIT_HEIGHT / 2), mjcf.GREEN_ARMOUR_RGBA, z=EXIT_HEIGHT / 2)
 
 
 class Labyrinth(base.MazeTask):

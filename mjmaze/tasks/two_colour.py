@@ -65,20 +65,18 @@ _NEVER = 1 << 40
 # Elements per array in the item draws' wall test (bounds memory for big batches).
 _CHUNK_ELEMENTS = 1 << 24
 
-# Colours as ViZDoom draws the released things (docs/look.md): the totem is
-# Doom's tall red or green column (things 32 / 30), the items Freedoom's green
-# armour and its "blue" armour, which Freedoom draws red (the released ACS calls
-# it the red armour).
+# As released (docs/objects.md, docs/look.md): the totem is Doom's tall red or
+# green column (things 32 / 30, 16 map units in radius and 52 high, as
+# Find-and-return's pillars); the items are Freedoom's green armour and its
+# "blue" armour, which Freedoom draws red (the released ACS calls it the red
+# armour), lying on the floor at their sprites' size; colours as ViZDoom draws them.
 RED, GREEN = mjcf.TALL_RED_COLUMN_RGBA, mjcf.TALL_GREEN_COLUMN_RGBA
-ITEM_RED, ITEM_GREEN = (0.59, 0.25, 0.24, 1.0), (0.42, 0.53, 0.33, 1.0)
-TOTEM_RADIUS, TOTEM_HEIGHT = 0.125, 1.0
-TOTEM = mjcf.ObjectGeom("totem", "cylinder", (TOTEM_RADIUS, TOTEM_HEIGHT / 2), RED, TOTEM_HEIGHT / 2, collides=True)
+ITEM_RED, ITEM_GREEN = mjcf.RED_ARMOUR_RGBA, mjcf.GREEN_ARMOUR_RGBA
+TOTEM = mjcf.floor_thing("totem", "cylinder", 32, 52, RED, collides=True)
+TOTEM_RADIUS = TOTEM.size[0]
 # The agent's centre never comes closer to the totem's than this.
 TOTEM_CLEARANCE = TOTEM_RADIUS + base.AGENT_RADIUS
-ITEM_HALF = 0.09
-ITEMS = tuple(
-    mjcf.ObjectGeom(f"item_{k}", "box", (ITEM_HALF, ITEM_HALF, ITEM_HALF), ITEM_RED, ITEM_HALF) for k in range(POOL_SIZE)
-)
+ITEMS = tuple(mjcf.floor_thing(f"item_{k}", "cylinder", 31, 17, ITEM_RED) for k in range(POOL_SIZE))
 
 
 class TwoColour(base.MazeTask):
