@@ -123,6 +123,11 @@ def test_resume_continues_step_count_and_optimizer_state(tmp_path):
     assert not torch.equal(before, after)
 
 
+def test_a_missing_checkpoint_is_named_as_missing(tmp_path):
+    with pytest.raises(checkpoint.CheckpointError, match="no checkpoint at .*step_000000000064.pt"):
+        checkpoint.load(tmp_path / "checkpoints" / "step_000000000064.pt")
+
+
 def test_a_corrupt_checkpoint_is_a_clear_error_and_stays_untouched(tmp_path):
     run = a2c.train(tiny(tmp_path))
     latest = checkpoint.checkpoints(run / "checkpoints")[-1]

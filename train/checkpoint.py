@@ -38,6 +38,8 @@ def save(directory: pathlib.Path, state: dict, step: int, keep: int) -> pathlib.
 
 def load(path: pathlib.Path, config: dict | None = None) -> dict:
     """Reads a checkpoint; checks it against ``config`` (the loading run's settings) if given."""
+    if not pathlib.Path(path).is_file():
+        raise CheckpointError(f"no checkpoint at {path}: pass one of the run's checkpoints/step_*.pt")
     try:
         state = torch.load(path, map_location="cpu", weights_only=True)
     except Exception as error:  # noqa: BLE001 - any failure to read is the same problem for the user
