@@ -42,10 +42,15 @@ PISTOL = (
 )
 
 
-def pistol_boxes(width: int, height: int) -> list[tuple[slice, slice, np.ndarray]]:
-    """``[(rows, cols, rgb)]``: the pistol's parts as slices of a ``height x width`` frame."""
+def pistol_boxes(width: int, height: int, shift: tuple[int, int] = (0, 0)) -> list[tuple[slice, slice, np.ndarray]]:
+    """``[(rows, cols, rgb)]``: the pistol's parts as slices of a ``height x width`` frame.
+
+    ``shift``: pixels (right, down) the pistol has swayed (head-bob), cut at the frame's edges.
+    """
+    dx, dy = shift
     return [
-        (slice(round(top * height), round(bottom * height)), slice(round(left * width), round(right * width)),
+        (slice(max(0, round(top * height) + dy), max(0, round(bottom * height) + dy)),
+         slice(max(0, round(left * width) + dx), max(0, round(right * width) + dx)),
          np.array(rgb, dtype=np.uint8))
         for (left, right, top, bottom), rgb in PISTOL
     ]
@@ -266,11 +271,12 @@ class EgoRenderer:
         """Re-sends a mesh whose vertices changed in the model."""
         mujoco.mjr_uploadMesh(self._model, self._context, mesh_id)
 
-    def render(self, data: mujoco.MjData, pistol: bool = True) -> np.ndarray:
+    def render(self, data: mujoco.MjData, pistol: bool = True, pistol_shift: tuple[int, int] = (0, 0)) -> np.ndarray:
         """Renders the current state; the result is a view into a reused buffer.
 
         Positions are brought up to date first: after ``mj_step`` they lag
         ``qpos`` by one tic, and objects may have just been moved.
+        ``pistol_shift``: pixels (right, down) the pistol has swayed.
         """
         mujoco.mj_kinematics(self._model, data)
         mujoco.mj_camlight(self._model, data)
@@ -280,7 +286,9 @@ class EgoRenderer:
         mujoco.mjr_setBuffer(self._offscreen, self._context)
         mujoco.mjr_render(self._viewport, self._scene, self._context)
         mujoco.mjr_readPixels(self._buffer, None, self._viewport, self._context)
-        for rows, cols, rgb in self._pistol if pistol else ():
+        boxes = self._pistol if pistol_shift == (0, 0) or not self._pistol else pistol_boxes(
+            self._frame.shape[1], self._frame.shape[0], pistol_shift)
+        for rows, cols, rgb in boxes if pistol else ():
             self._frame[rows, cols] = rgb
         return self._frame
 

@@ -214,7 +214,8 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         self._actions = torch.tensor(task.actions, dtype=torch.float64, device=dev)  # (A, 2): forward, turn
 
         with wp.ScopedDevice(self._wp_device):
-            self._model = mjw.put_model(mjm, batch_sizes={"geom_pos": n, "geom_rgba": n, "geom_dataid": n})
+            batched = {"geom_pos": n, "geom_rgba": n, "geom_dataid": n} | ({"cam_pos": n} if task.head_bob else {})
+            self._model = mjw.put_model(mjm, batch_sizes=batched)
             self._data = mjw.put_data(mjm, mujoco.MjData(mjm), nworld=n, nconmax=_CONTACTS_PER_WORLD, njmax=_CONTACTS_PER_WORLD)
             self._render = mjw.create_render_context(
                 mjm, nworld=n, cam_res=(width, height), render_rgb=True, render_depth=False,
@@ -230,6 +231,8 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         self._geom_pos = wp.to_torch(self._model.geom_pos)
         self._geom_rgba = wp.to_torch(self._model.geom_rgba)
         self._geom_dataid = wp.to_torch(self._model.geom_dataid)
+        self._cam_pos = wp.to_torch(self._model.cam_pos)  # per world with head-bob
+        self._camera = mujoco.mj_name2id(mjm, mujoco.mjtObj.mjOBJ_CAMERA, base.CAMERA)
         self._rgb_packed = wp.to_torch(self._render.rgb_data)
         # The pistol over each frame, as the CPU renderer draws it (mjmaze.render.PISTOL).
         self._pistol = [
@@ -244,6 +247,9 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         self._ended = torch.zeros(n, dtype=torch.bool, device=dev)
         self._path = torch.zeros((n, base.TICS_PER_STEP, 2), dtype=torch.float64, device=dev)
         self._turn_held = torch.zeros(n, dtype=torch.float64, device=dev)  # tics a turn key has been held
+        self._bob = torch.zeros(n, dtype=torch.float64, device=dev)  # Doom's walking bob of the last tic
+        self._rows = torch.arange(height, device=dev)
+        self._cols = torch.arange(width, device=dev)
         self._obs = torch.zeros((n, height, width, 3), dtype=torch.uint8, device=dev)
         self.state: dict[str, torch.Tensor] | None = None
         self._info_fields = task.info_fields()
@@ -328,6 +334,7 @@ class MazeBatchEnv(gym.vector.VectorEnv):
             qpos[:, :2] -= ahead
             qvel[:, :2] *= base.FRICTION
             self._path[:, tic] = qpos[:, :2]
+        self._bob = base.walking_bob(self.xp, vx, vy, dt)
 
     def _start_episodes(self, envs: torch.Tensor) -> None:
         """New episodes in ``envs`` (indices): configuration, the scenario's start, the arena."""
@@ -347,6 +354,7 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         self._qpos[envs, 0:3] = pose.float()
         self._qvel[envs] = 0.0
         self._turn_held[envs] = 0
+        self._bob[envs] = 0.0
         self._warmstart[envs] = 0.0
         # The maze: its wall boxes, its wall mesh.
         geom_pos = self._geom_pos
@@ -377,6 +385,9 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         if not self._rendering:
             return
         m, d, rc = self._model, self._data, self._render
+        if self.task.head_bob:
+            eye_dz, pistol_dx, pistol_dy = base.view_bob(self.xp, self._bob, self.state["steps"] * base.TICS_PER_STEP)
+            self._cam_pos[:, self._camera, 2] = (mjcf.EYE_HEIGHT + eye_dz).float()
         mjw.kinematics(m, d)  # positions lag a step behind mjw.step's integration
         mjw.camlight(m, d)
         mjw.refit_bvh(m, d, rc)
@@ -384,8 +395,20 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         # Packed 0xAABBGGRR per pixel: bytes R, G, B, A in memory.
         packed = self._rgb_packed.view(torch.uint8).view(self.num_envs, self.task.height, self.task.width, 4)
         self._obs.copy_(packed[..., [2, 1, 0]])
+        if self.task.head_bob and self._pistol:
+            self._draw_swayed_pistol(torch.round(pistol_dx * self.task.width).long(),
+                                     torch.round(pistol_dy * self.task.height).long())
+            return
         for rows, cols, rgb in self._pistol:
             self._obs[:, rows, cols] = rgb
+
+    def _draw_swayed_pistol(self, dx: torch.Tensor, dy: torch.Tensor) -> None:
+        """The pistol's boxes, each env's shifted by its own ``(dx, dy)`` pixels (as :func:`mjmaze.render.pistol_boxes`)."""
+        for rows, cols, rgb in self._pistol:
+            in_rows = (self._rows >= rows.start + dy[:, None]) & (self._rows < rows.stop + dy[:, None])  # (N, H)
+            in_cols = (self._cols >= cols.start + dx[:, None]) & (self._cols < cols.stop + dx[:, None])  # (N, W)
+            inside = in_rows[:, :, None, None] & in_cols[:, None, :, None]
+            torch.where(inside, rgb, self._obs, out=self._obs)  # no boolean indexing: it would wait on the GPU
 
     def segmentation(self) -> torch.Tensor:
         """``(N, H, W)`` geom id drawn at each pixel of the last frames, -1 for none (needs ``render_segmentation``)."""

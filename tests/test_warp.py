@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import mjmaze
-from mjmaze import registry, suite
+from mjmaze import mjcf, registry, render, suite
 from mjmaze.tasks import base
 
 torch = pytest.importorskip("torch")
@@ -116,6 +116,28 @@ def test_task_arguments_carry_over():
                         "split": "test", "num_configs": 3, "config_sampling": "random"},
         num_envs=3, steps=40, frames_every=10,
     )
+
+
+def test_head_bob_moves_each_worlds_eye_and_pistol_as_the_cpu_task():
+    kwargs = {"size": 5, "head_bob": True}
+    batch = mjwarp.MazeBatchEnv(2, "labyrinth", device="cpu", **kwargs)
+    batch.reset(seed=SEED)
+    cpus = _cpu_twins("labyrinth", kwargs, 2, batch)
+    _, _, hand = render.pistol_boxes(1, 1)[1]
+    swing = 0.0
+    for step in range(16):
+        actions = np.array([2, 3 if step < 8 else 0])  # walk; walk left, then turn in place
+        obs, _, terminated, truncated, _ = batch.step(torch.as_tensor(actions))
+        assert not (terminated.any() or truncated.any())
+        eyes = mjwarp.wp.to_torch(batch._data.cam_xpos)[:, batch._camera, 2].numpy()
+        for i, env in enumerate(cpus):
+            env.task.advance(env.physics, int(actions[i]))
+            frame = env.task.get_observation(env.physics)["pixels"]
+            assert eyes[i] == pytest.approx(env.physics.named.data.cam_xpos[base.CAMERA][2], abs=1e-4), (step, i)
+            # The swayed pistol covers the same pixels (its hand, drawn in its own colour on both).
+            assert np.array_equal((obs[i].numpy() == hand).all(-1), (frame == hand).all(-1)), (step, i)
+            swing = max(swing, abs(eyes[i] - mjcf.EYE_HEIGHT))
+    assert swing > 0.03  # the eyes did bob (by up to 8 map units, 6 cm)
 
 
 def test_a_released_layout_that_spawns_inside_the_totem(tmp_path):

@@ -16,7 +16,16 @@ from mjmaze.files import atomic_write
 
 PREFIX, SUFFIX = "step_", ".pt"
 # What must agree between a checkpoint and the run that loads it.
-IDENTITY_KEYS = ("scenario", "size", "num_items", "complexity", "num_envs", "num_steps")
+IDENTITY_KEYS = ("scenario", "size", "num_items", "complexity", "num_envs", "num_steps", "head_bob")
+# Settings that runs saved before they existed ran with.
+MISSING_MEANS = {"head_bob": False}
+
+
+def identity_differences(saved: dict, now: dict) -> dict:
+    """``{key: (saved value, value now)}`` of the :data:`IDENTITY_KEYS` that differ between two run configs."""
+    def value(config, key):
+        return config.get(key, MISSING_MEANS.get(key))
+    return {k: (value(saved, k), value(now, k)) for k in IDENTITY_KEYS if value(saved, k) != value(now, k)}
 
 
 class CheckpointError(RuntimeError):
@@ -51,7 +60,7 @@ def load(path: pathlib.Path, config: dict | None = None) -> dict:
     if missing:
         raise CheckpointError(f"{path} is not an mjmaze A2C checkpoint (missing {sorted(missing)}); it was left untouched.")
     if config is not None:
-        differ = {k: (state["config"].get(k), config.get(k)) for k in IDENTITY_KEYS if state["config"].get(k) != config.get(k)}
+        differ = identity_differences(state["config"], config)
         if differ:
             detail = ", ".join(f"{k}: checkpoint {a!r} vs now {b!r}" for k, (a, b) in differ.items())
             raise CheckpointError(f"{path} belongs to a different run ({detail}); it was left untouched.")

@@ -49,6 +49,8 @@ class _RunSettings:
     """env worker processes beside the training process, which steps a share of the envs too (None: the usable cores less one)"""
     device: str = "auto"
     """auto (CUDA when available), cpu or cuda"""
+    head_bob: bool = True
+    """Doom's head-bob while walking (the eye swings, the pistol sways); --no-head-bob keeps the view still"""
     backend: str = "cpu"
     """where the envs run: cpu (worker processes) or warp (every env in one MuJoCo Warp model on --device, beside the network; pip install "mjmaze[warp]")"""
     torch_threads: int | None = None
@@ -76,6 +78,8 @@ class _RunSettings:
         kwargs = {k: v for k, v in kwargs.items() if v is not None}
         if self.num_configs is not None:
             kwargs["num_configs"] = self.num_configs
+        if not self.head_bob:
+            kwargs["head_bob"] = False
         return kwargs
 
     def name(self) -> str:

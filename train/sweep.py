@@ -112,6 +112,23 @@ def finished(run_dir: pathlib.Path, total_steps: int) -> dict | None:
     return result if result.get("step", 0) >= total_steps else None
 
 
+def check_same_run(run_dir: pathlib.Path, config: dict) -> None:
+    """Raises ValueError if ``run_dir`` holds a run trained with other settings than ``config``.
+
+    A sweep resumes or skips the runs it finds; one saved with other
+    settings (e.g. without head-bob) would be resumed or reported as this one.
+    """
+    try:
+        saved = json.loads((run_dir / "config.json").read_text())
+    except FileNotFoundError:
+        return
+    differ = checkpoint.identity_differences(saved, config)
+    if differ:
+        detail = ", ".join(f"{k}: saved {a!r} vs now {b!r}" for k, (a, b) in differ.items())
+        raise ValueError(f"{run_dir} holds a run with other settings ({detail}); "
+                         "move it aside (nothing was changed) or pass --name for a new sweep folder")
+
+
 def run_one(spec: RunSpec, settings: dict, sweep_dir: str, eval_envs: int, eval_configs: int) -> dict:
     """Trains (or resumes) one run, then evaluates it; what a Ray task runs."""
     args = spec.args(settings, pathlib.Path(sweep_dir))
@@ -188,6 +205,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--scenario", default=None, help="--grid custom: the scenario")
     parser.add_argument("--difficulties", type=int, nargs="+", default=None, help="--grid custom: sizes, K or c")
     parser.add_argument("--num-configs", type=int, nargs="+", default=None, help="--grid custom: training set sizes")
+    parser.add_argument("--only", nargs="+", default=None, metavar="RUN",
+                        help="run only these runs of the grid (their folder names, e.g. k_item_num_items2_s0)")
     parser.add_argument("--total-steps", type=int, default=None,
                         help=f"agent steps per run (default: {DEFAULT_STEPS})")
     parser.add_argument("--num-envs", type=int, default=Args.num_envs)
@@ -210,6 +229,12 @@ def main(argv: list[str] | None = None) -> None:
         specs = grid(args.grid, args.seeds, args.scenario, args.difficulties, args.num_configs)
     except ValueError as error:
         raise SystemExit(f"error: {error}") from None
+    if args.only:
+        unknown = sorted(set(args.only) - {spec.name for spec in specs})
+        if unknown:
+            raise SystemExit(f"error: --only {unknown}: not runs of --grid {args.grid}; its runs: "
+                             f"{[spec.name for spec in specs]}")
+        specs = [spec for spec in specs if spec.name in args.only]
     if args.total_steps:  # one length for every run, the grid's own lengths overridden
         specs = [dataclasses.replace(spec, total_steps=None) for spec in specs]
     total_steps = args.total_steps or DEFAULT_STEPS[args.grid]
@@ -220,13 +245,15 @@ def main(argv: list[str] | None = None) -> None:
         # The training process steps a share of the envs itself: one worker fewer than the run's CPUs.
         "num_workers": args.cpus_per_run - 1, "torch_threads": args.cpus_per_run,
     }
+    sweep_dir = args.sweeps_dir / (args.name or args.grid)
     try:
         for spec in specs:
             # Every run's task is valid before anything starts.
-            suite.make_task(spec.scenario, spec.args(settings, args.sweeps_dir).task_kwargs())
+            run_args = spec.args(settings, args.sweeps_dir)
+            suite.make_task(spec.scenario, run_args.task_kwargs())
+            check_same_run(sweep_dir / spec.name, dataclasses.asdict(run_args))
     except ValueError as error:
         raise SystemExit(f"error: {error}") from None
-    sweep_dir = args.sweeps_dir / (args.name or args.grid)
     files.atomic_write_json(sweep_dir / "sweep.json", {
         "grid": args.grid, "runs": [s.name for s in specs], "settings": settings, "command": sys.argv,
         "run_steps": {s.name: s.total_steps or total_steps for s in specs},

@@ -46,6 +46,17 @@ SLOW_TURN_TICS = 5  # a turn key's first tics turn at half rate (ZDoom's SLOWTUR
 # At full speed in open space: 0.261 m and 14.06 degrees per agent step.
 FORWARD_PER_STEP = TICS_PER_STEP * THRUST_PER_TIC / (1 - FRICTION)
 TURN_PER_STEP = TICS_PER_STEP * TURN_PER_TIC
+# Head-bob (``head_bob=True``): Doom's P_CalcHeight and P_BobWeapon, measured in
+# ViZDoom (docs/look.md). Walking swings the eye by half the "bob", min(v^2 / 4, 16)
+# map units with v the speed after the tic's thrust in units per tic, with a
+# 20-tic period, and drops and sways the pistol by the whole bob (in 320x180
+# screen pixels) with a 64-tic period. The phases run on the level's clock,
+# which the released configs start at tic 10.
+MAX_BOB = 16.0  # map units (Doom's MAXBOB)
+EPISODE_START_TIC = 10  # the released .cfg files' episode_start_time
+EYE_BOB_TICS = 20
+PISTOL_BOB_TICS = 64
+PISTOL_BOB_PIXELS = (0.751 / 320, 0.903 / 180)  # (x, y) shift per unit of bob, as fractions of the frame
 PICKUP_RADIUS = rules.PICKUP_RADIUS
 AGENT_RADIUS = 0.125
 
@@ -78,6 +89,8 @@ class MazePhysics(mujoco.Physics):
     command: tuple[int, int] = (0, 0)
     #: Tics a turn key has been held without a break (Doom's slow start of a turn).
     turn_held: int = 0
+    #: Doom's walking bob (map units) of the last tic: see :func:`view_bob`.
+    bob: float = 0.0
 
     def step(self, nstep: int = 1) -> None:
         """Advances ``nstep`` tics of :attr:`command`; walls and pillars stop the agent at its radius.
@@ -104,6 +117,7 @@ class MazePhysics(mujoco.Physics):
             for tic in range(nstep):
                 vx, vy, yaw_rate, held = tic_motion(math, vx, vy, float(qpos[2]), forward, turn, held, dt)
                 qvel[0], qvel[1], qvel[2] = vx, vy, yaw_rate
+                thrust_vx, thrust_vy = vx, vy  # Doom's bob reads the velocity here
                 # Only x and y matter (the agent is a sphere).
                 ahead_x, ahead_y = vx * dt, vy * dt
                 qpos[0] += ahead_x
@@ -116,6 +130,8 @@ class MazePhysics(mujoco.Physics):
                 tic_xy[tic] = qpos[:2]
         qvel[0], qvel[1] = vx, vy
         self.turn_held = held
+        if nstep:
+            self.bob = float(walking_bob(np, thrust_vx, thrust_vy, dt))
 
     def agent_pose(self) -> tuple[float, float, float]:
         """``(x, y, yaw)`` of the agent; yaw in radians in ``(-pi, pi]``, 0 facing +x."""
@@ -126,6 +142,7 @@ class MazePhysics(mujoco.Physics):
         self.data.qpos[:3] = (x, y, yaw)
         self.data.qvel[:3] = 0.0
         self.turn_held = 0
+        self.bob = 0.0
 
     def object_ids(self, names: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
         """``(ids for place_objects, geom ids)`` of scenario objects (see :class:`mjmaze.mjcf.ObjectGeom`).
@@ -190,12 +207,17 @@ class MazeTask(base.Task):
         height: int = DEFAULT_HEIGHT,
         layouts: str | os.PathLike | None = None,
         visual_style: str = "textured",
+        head_bob: bool = True,
         random=None,
     ):
         super().__init__(random=random)
         _check_choice("visual_style", visual_style, mjcf.VISUAL_STYLES)
         #: "textured" (default: the depth cues of the paper's frames) or "flat" (cheaper); see mjmaze.mjcf.
         self.visual_style = visual_style
+        if not isinstance(head_bob, (bool, np.bool_)):
+            raise ValueError(f"head_bob must be True or False, got {head_bob!r}")
+        #: Doom's head-bob while walking: the eye swings, the pistol sways (:func:`view_bob`).
+        self.head_bob = bool(head_bob)
         _check_choice("split", split, configs.SPLITS)
         _check_choice("config_sampling", config_sampling, configs.CONFIG_SAMPLING)
         _check_choice("action_set", action_set, tuple(ACTION_SETS))
@@ -255,6 +277,7 @@ class MazeTask(base.Task):
         self._renderer = render.EgoRenderer(
             model, CAMERA, self.width, self.height, pistol=self.visual_style == "textured"
         )
+        self._eye = model.cam(CAMERA).pos  # a view into the model: head-bob moves it
         fovy = math.radians(model.cam(CAMERA).fovy[0])
         self.horizontal_fov = 2 * math.atan(math.tan(fovy / 2) * self.width / self.height)
         self._config_in_model = None
@@ -417,7 +440,7 @@ class MazeTask(base.Task):
 
     def get_observation(self, physics: MazePhysics) -> collections.OrderedDict:
         self._bind(physics)
-        frame = self._renderer.render(self._bound_data)
+        frame = self._renderer.render(self._bound_data, pistol_shift=self._bob_view(physics))
         if self.observation_buffer is None:
             return collections.OrderedDict(pixels=frame.copy())
         np.copyto(self.observation_buffer, frame)
@@ -426,7 +449,16 @@ class MazeTask(base.Task):
     def segmentation(self, physics: MazePhysics) -> np.ndarray:
         """``(H, W)``: the geom id the agent sees at each pixel of its view, -1 for none (the sky)."""
         self._bind(physics)
+        self._bob_view(physics)
         return self._renderer.segmentation(self._bound_data)
+
+    def _bob_view(self, physics: MazePhysics) -> tuple[int, int]:
+        """Puts the eye where head-bob has it now; returns the pistol's shift in pixels (right, down)."""
+        if not self.head_bob:
+            return 0, 0
+        eye_dz, pistol_dx, pistol_dy = view_bob(math, physics.bob, self.steps * TICS_PER_STEP)
+        self._eye[2] = mjcf.EYE_HEIGHT + eye_dz
+        return round(pistol_dx * self.width), round(pistol_dy * self.height)
 
     def get_reward(self, physics: MazePhysics) -> float:
         return self._reward
@@ -506,6 +538,26 @@ def tic_motion(xp, vx, vy, yaw, forward, turn, turn_held, timestep: float):
     heading = yaw + yaw_rate * timestep
     thrust = forward * THRUST_PER_TIC / timestep
     return vx + thrust * xp.cos(heading), vy + thrust * xp.sin(heading), yaw_rate, turn_held
+
+
+def walking_bob(xp, vx, vy, timestep: float):
+    """Doom's bob in map units of a tic whose velocity after its thrust is ``(vx, vy)`` (m/s)."""
+    speed_sq = (vx * vx + vy * vy) * (timestep / MAP_UNIT) ** 2  # (map units per tic)^2
+    return xp.minimum(speed_sq / 4, MAX_BOB)
+
+
+def view_bob(xp, bob, tics):
+    """``(eye_dz, pistol_dx, pistol_dy)`` of ``tics`` tics into an episode whose last tic's bob was ``bob``.
+
+    ``eye_dz`` in metres (up), the pistol's shift as fractions of the frame
+    (right, down). Works on floats (``xp = math``) and arrays, as :func:`tic_motion`.
+    """
+    level_time = EPISODE_START_TIC + tics
+    eye_dz = bob / 2 * xp.sin(math.tau * (level_time - 1) / EYE_BOB_TICS) * MAP_UNIT
+    angle = math.tau * level_time / PISTOL_BOB_TICS
+    pistol_dx = bob * xp.cos(angle) * PISTOL_BOB_PIXELS[0]
+    pistol_dy = bob * abs(xp.sin(angle)) * PISTOL_BOB_PIXELS[1]
+    return eye_dz, pistol_dx, pistol_dy
 
 
 def make_environment(task: MazeTask, environment_kwargs: dict | None = None) -> control.Environment:
