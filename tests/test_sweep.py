@@ -105,6 +105,22 @@ def test_a_run_asking_for_a_gpu_ray_lacks_is_one_clear_error(tmp_path):
         sweep.main(["--grid", "small", "--num-cpus", "2", "--gpus-per-run", "64", "--sweeps-dir", str(tmp_path)])
 
 
+def test_a_run_folder_with_other_settings_is_refused_and_left_alone(tmp_path):
+    run = tmp_path / "evidence" / "labyrinth_size7_s0"
+    run.mkdir(parents=True)
+    saved = json.dumps({"scenario": "labyrinth", "size": 7, "num_envs": 16, "num_steps": 128})  # before head-bob
+    (run / "config.json").write_text(saved)
+    with pytest.raises(SystemExit, match="other settings \\(head_bob: saved False vs now True\\); move it aside"):
+        sweep.main(["--grid", "evidence", "--only", "labyrinth_size7_s0", "--sweeps-dir", str(tmp_path)])
+    assert (run / "config.json").read_text() == saved
+    assert not (tmp_path / "evidence" / "sweep.json").exists()
+
+
+def test_only_names_runs_of_the_grid(tmp_path):
+    with pytest.raises(SystemExit, match="--only \\['k_item_s0'\\]: not runs of --grid evidence; its runs: "):
+        sweep.main(["--grid", "evidence", "--only", "k_item_s0", "--sweeps-dir", str(tmp_path)])
+
+
 def test_report_of_a_folder_without_runs_is_one_clear_error(tmp_path):
     with pytest.raises(SystemExit, match="no run folders"):
         report.main([str(tmp_path)])

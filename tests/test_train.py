@@ -149,6 +149,17 @@ def test_a_checkpoint_of_another_run_is_refused(tmp_path):
     assert latest.read_bytes() == before
 
 
+def test_a_checkpoint_from_before_head_bob_resumes_only_without_it(tmp_path):
+    run = a2c.train(tiny(tmp_path, head_bob=False))
+    latest = checkpoint.checkpoints(run / "checkpoints")[-1]
+    state = torch.load(latest, weights_only=True)
+    del state["config"]["head_bob"]  # as saved before the setting existed
+    torch.save(state, latest)
+    assert checkpoint.load(latest, {**state["config"], "head_bob": False})["step"] == state["step"]
+    with pytest.raises(checkpoint.CheckpointError, match="head_bob: checkpoint False vs now True"):
+        checkpoint.load(latest, {**state["config"], "head_bob": True})
+
+
 def test_flags_for_another_scenario_are_refused():
     with pytest.raises(ValueError, match="takes no \\['complexity'\\]"):
         run_settings.Args(scenario="labyrinth", complexity=3).task_kwargs()
