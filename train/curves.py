@@ -70,17 +70,25 @@ def evaluate_checkpoints(run_dir: pathlib.Path, num_envs: int = 16) -> None:
 
 
 def group_key(config: dict) -> tuple:
-    """What makes runs seeds of one curve: the scenario, its difficulty, the number of training configurations."""
+    """What makes runs seeds of one curve: the scenario, its difficulty, the number of training configurations,
+    and what the agent saw (head-bob; runs saved before it existed ran without)."""
     return (config["scenario"], config.get("size"), config.get("num_items"), config.get("complexity"),
-            config.get("num_configs"))
+            config.get("num_configs"), config.get("head_bob", checkpoint.MISSING_MEANS["head_bob"]))
 
 
-def label(config: dict) -> str:
+def setting(config: dict) -> str:
+    """The scenario and difficulty, e.g. ``labyrinth size=7`` (the paper's curve is of this)."""
     parts = [config["scenario"]]
     for key in ("size", "num_items", "complexity", "num_configs"):
         if config.get(key) is not None:
             parts.append(f"{key}={config[key]}")
     return " ".join(parts)
+
+
+def label(config: dict) -> str:
+    """The setting, and what set this group's frames apart (no head-bob)."""
+    no_bob = not config.get("head_bob", checkpoint.MISSING_MEANS["head_bob"])
+    return setting(config) + (" (no head-bob)" if no_bob else "")
 
 
 def binned(runs: list[dict], bins: int) -> dict:
@@ -130,7 +138,7 @@ def curves(run_dirs: list[pathlib.Path], bins: int = BINS, each_run: bool = Fals
         declared = registry.get(config["scenario"])
         paper = declared.paper_curves.get(config.get(declared.difficulty), ()) if not config.get("num_configs") else ()
         result.append({
-            "label": key[0] if each_run else label(config), "setting": label(config), "scenario": config["scenario"], "units": declared.curve_units,
+            "label": key[0] if each_run else label(config), "setting": setting(config), "scenario": config["scenario"], "units": declared.curve_units,
             "eval_units": declared.metric_units,
             "runs": [r["dir"] for r in runs], "training": binned(runs, bins), "evaluations": evaluations(runs),
             "paper": {"step": [s for s, _ in paper], "value": [v for _, v in paper]},
