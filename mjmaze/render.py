@@ -236,6 +236,7 @@ class EgoRenderer:
         gl_context()
         self._map_view = map_view
         self._pistol = pistol_boxes(width, height) if pistol else []
+        self._swayed_pistol = {(0, 0): self._pistol}
         model.vis.global_.offwidth = max(model.vis.global_.offwidth, width)
         model.vis.global_.offheight = max(model.vis.global_.offheight, height)
         self._model = model
@@ -286,10 +287,12 @@ class EgoRenderer:
         mujoco.mjr_setBuffer(self._offscreen, self._context)
         mujoco.mjr_render(self._viewport, self._scene, self._context)
         mujoco.mjr_readPixels(self._buffer, None, self._viewport, self._context)
-        boxes = self._pistol if pistol_shift == (0, 0) or not self._pistol else pistol_boxes(
-            self._frame.shape[1], self._frame.shape[0], pistol_shift)
-        for rows, cols, rgb in boxes if pistol else ():
-            self._frame[rows, cols] = rgb
+        if pistol and self._pistol:
+            boxes = self._swayed_pistol.get(pistol_shift)
+            if boxes is None:  # head-bob sways it over a few dozen shifts: each computed once
+                boxes = self._swayed_pistol[pistol_shift] = pistol_boxes(*self._frame.shape[1::-1], pistol_shift)
+            for rows, cols, rgb in boxes:
+                self._frame[rows, cols] = rgb
         return self._frame
 
     def segmentation(self, data: mujoco.MjData) -> np.ndarray:
