@@ -99,6 +99,22 @@ def test_a_placed_or_turning_agent_does_not_bob():
     env.task.close()
 
 
+def test_walking_into_a_wall_stops_the_bob():
+    # ViZDoom, from (0, 400) facing the north wall and holding forward: the eye reaches 49 at tic 46,
+    # then the wall stops the player (y 624) and the eye stays within 0.1 unit of 41 (velocity 0).
+    env = open_room(width=112, height=64)
+    env.physics.set_agent_pose(1.5, 400 * mjcf.MAP_UNIT, math.pi / 2)
+    eyes, ys = [], []
+    for _ in range(18):
+        env.step(FORWARD)
+        eyes.append(eye_units(env))
+        ys.append(env.physics.agent_pose()[1])
+    assert max(eyes[:9]) > 7.5  # full swing while walking
+    assert np.ptp(ys[-6:]) < 1e-3  # stopped by the wall
+    assert np.abs(eyes[-6:]).max() < 0.15
+    env.task.close()
+
+
 def test_head_bob_is_on_by_default_and_off_keeps_the_view_still():
     still, bobbing = open_room(head_bob=False, width=112, height=64), open_room(width=112, height=64)
     for _ in range(9):
