@@ -103,6 +103,22 @@ def test_two_colour_objects_2m_ahead_have_vizdooms_colours(name, rgba, doom):
     env.task.close()
 
 
+def test_k_items_first_two_kinds_are_the_released_armours_as_vizdoom_draws_them():
+    from mjmaze.tasks import k_item
+
+    green, red = (geom for _, geom in k_item.KINDS[:2])
+    assert (green.rgba, red.rgba) == (two_colour.ITEM_GREEN, two_colour.ITEM_RED)
+    env = empty_room(mjcf.STONE_ROOM)  # K-item's room
+    physics = env.physics
+    ids = physics.object_ids([two_colour.ITEMS[0].name])
+    physics.set_object_rgba(ids[1][0], green.rgba)
+    physics.show_objects(ids[1], True)
+    physics.place_objects(ids[0], np.array([[2.0, 0.0]]))
+    # ViZDoom's green armour 2 m ahead in the STONE2 room (the Labyrinth exit's measurement): (49, 59, 37).
+    assert object_colour(env, two_colour.ITEMS[0].name, (0.0, 0.0, 0.0)) == pytest.approx((49, 59, 37), abs=CLOSE)
+    env.task.close()
+
+
 def test_find_return_pillars_are_doom_columns():
     assert find_return.RED_PILLAR.rgba == mjcf.TALL_RED_COLUMN_RGBA == two_colour.RED
     assert find_return.GREEN_PILLAR.rgba == mjcf.TALL_GREEN_COLUMN_RGBA == two_colour.GREEN

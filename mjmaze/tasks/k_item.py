@@ -42,11 +42,16 @@ STEP_REWARD = -0.0001 * base.TICS_PER_STEP
 # Item kinds in collection order: (colour code in the released files, geom).
 # Sizes are those of the things the released generators place, in this order
 # (docs/objects.md): green armour 2018, blue armour 2019, medikit 2012,
-# soulsphere 2013, red and blue keycards 13 and 5; colours are the spec's.
+# soulsphere 2013, red and blue keycards 13 and 5. The first two are drawn in
+# the colours ViZDoom draws those armours (Freedoom's blue armour is red), as
+# Two-colour's items and the Labyrinth exit: the spec's saturated green and red
+# stood out of the dim frame far more than the released olive and dull red
+# (README "Learning", K-item). The others keep the spec's hues: Freedoom's
+# medikit, soulsphere and keycards are not measured yet.
 # The two greys (K = 8) are not in the released files we have: our shapes.
 KINDS = (
-    ("g", mjcf.floor_thing("item_green", "cylinder", 31, 17, (0.1, 0.85, 0.1, 1.0))),
-    ("r", mjcf.floor_thing("item_red", "cylinder", 31, 17, (0.95, 0.1, 0.1, 1.0))),
+    ("g", mjcf.floor_thing("item_green", "cylinder", 31, 17, mjcf.GREEN_ARMOUR_RGBA)),
+    ("r", mjcf.floor_thing("item_red", "cylinder", 31, 17, mjcf.RED_ARMOUR_RGBA)),
     ("b", mjcf.floor_thing("item_blue", "cylinder", 28, 19, (0.15, 0.25, 1.0, 1.0))),
     ("c", mjcf.floor_thing("item_cyan", "sphere", 24, 24, (0.0, 0.9, 0.9, 1.0))),
     ("m", mjcf.floor_thing("item_magenta", "cylinder", 14, 16, (0.9, 0.1, 0.9, 1.0))),
