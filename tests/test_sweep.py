@@ -121,6 +121,14 @@ def test_only_names_runs_of_the_grid(tmp_path):
         sweep.main(["--grid", "evidence", "--only", "k_item_s0", "--sweeps-dir", str(tmp_path)])
 
 
+def test_only_runs_in_the_order_asked(tmp_path, monkeypatch):
+    asked = ["two_colour_complexity1_s1", "k_item_num_items2_s0", "two_colour_complexity1_s1"]
+    launched = []
+    monkeypatch.setattr(sweep, "launch", lambda specs, *a, **k: launched.extend(s.name for s in specs) or [])
+    sweep.main(["--grid", "evidence", "--only", *asked, "--sweeps-dir", str(tmp_path)])
+    assert launched == asked[:2]
+
+
 def test_report_of_a_folder_without_runs_is_one_clear_error(tmp_path):
     with pytest.raises(SystemExit, match="no run folders"):
         report.main([str(tmp_path)])

@@ -206,7 +206,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--difficulties", type=int, nargs="+", default=None, help="--grid custom: sizes, K or c")
     parser.add_argument("--num-configs", type=int, nargs="+", default=None, help="--grid custom: training set sizes")
     parser.add_argument("--only", nargs="+", default=None, metavar="RUN",
-                        help="run only these runs of the grid (their folder names, e.g. k_item_num_items2_s0)")
+                        help="run only these runs of the grid, in this order (their folder names, e.g. "
+                             "k_item_num_items2_s0)")
     parser.add_argument("--total-steps", type=int, default=None,
                         help=f"agent steps per run (default: {DEFAULT_STEPS})")
     parser.add_argument("--num-envs", type=int, default=Args.num_envs)
@@ -234,7 +235,8 @@ def main(argv: list[str] | None = None) -> None:
         if unknown:
             raise SystemExit(f"error: --only {unknown}: not runs of --grid {args.grid}; its runs: "
                              f"{[spec.name for spec in specs]}")
-        specs = [spec for spec in specs if spec.name in args.only]
+        by_name = {spec.name: spec for spec in specs}
+        specs = [by_name[name] for name in dict.fromkeys(args.only)]  # the order asked for, each once
     if args.total_steps:  # one length for every run, the grid's own lengths overridden
         specs = [dataclasses.replace(spec, total_steps=None) for spec in specs]
     total_steps = args.total_steps or DEFAULT_STEPS[args.grid]
