@@ -29,7 +29,7 @@ import numpy as np
 
 import mjmaze
 from mjmaze import configs, maze, render
-from mjmaze.tasks import base, find_return, two_colour
+from mjmaze.tasks import base, find_return, k_item, two_colour
 
 UNITS = 128  # Doom map units per metre (mjmaze's 1 m cell is the generator's 128 units)
 WALL_PAD = 8  # the generator's half thickness of a wall block
@@ -40,6 +40,9 @@ RAISE_TICS = 8  # the pistol is still being raised for ~6 tics after the release
 STONE = ("STONE2", "FLAT1_1", "MFLR8_1")  # Labyrinth, Find-and-return, K-item
 SLIME = ("GSTONE1", "NUKAGE1", "CEIL4_1")  # Two-colour
 GREEN_ARMOUR, BLUE_ARMOUR, GREEN_COLUMN, RED_COLUMN = 2018, 2019, 30, 32
+# K-item's things in collection order, as the released generator places them (docs/objects.md).
+K_ITEM_THINGS = ((GREEN_ARMOUR, "green armour"), (BLUE_ARMOUR, "blue armour"), (2012, "medikit"),
+                 (2013, "soulsphere"), (13, "red keycard"), (5, "blue keycard"))
 # Wall patch (centre of the frame), floor band and ceiling band of a 112x64 frame.
 WALL_PATCH = (slice(24, 32), slice(50, 62))
 FLOOR_BAND = (slice(40, 64), slice(0, 40))  # the floor from ~2 m to the frame's foot, left of the pistol
@@ -238,22 +241,30 @@ def calibrate() -> None:
                      if d == 4 else ""))
         env.task.close()
     print("objects straight ahead down a corridor, cells:  (Doom | mjmaze), mean colour where drawn")
+    # (label, scenario, task kwargs, the object's cell, Doom's things, mjmaze's object, objects hidden)
     cases = [
         ("labyrinth exit (green armour)", "labyrinth", {"size": 7}, lambda c: c.object_cells[0],
-         lambda c: [Thing(*cell_xy(c, c.object_cells[0]), GREEN_ARMOUR)], ["exit"]),
+         lambda c: [Thing(*cell_xy(c, c.object_cells[0]), GREEN_ARMOUR)], "exit", []),
         ("find-return red pillar (tall red column)", "find_return", {"size": 7}, lambda c: c.object_cells[0],
-         lambda c: [Thing(*cell_xy(c, c.object_cells[0]), RED_COLUMN)], [find_return.RED_PILLAR.name]),
+         lambda c: [Thing(*cell_xy(c, c.object_cells[0]), RED_COLUMN)], find_return.RED_PILLAR.name,
+         [find_return.GREEN_PILLAR.name]),
     ]
-    for label, scenario, kwargs, cell_of, things_of, objects in cases:
+    kinds = [geom.name for _, geom in k_item.KINDS[:len(K_ITEM_THINGS)]]
+    for kind, (thing, sprite) in enumerate(K_ITEM_THINGS):
+        cases.append((f"k-item kind {kind + 1} ({sprite})", "k_item", {"num_items": len(K_ITEM_THINGS)},
+                      lambda c, kind=kind: c.object_cells[kind],
+                      lambda c, kind=kind, thing=thing: [Thing(*cell_xy(c, c.object_cells[kind]), thing)],
+                      kinds[kind], kinds[:kind] + kinds[kind + 1:]))
+    for label, scenario, kwargs, cell_of, things_of, name, hidden in cases:
         env, config, poses = scenario_maze(scenario, kwargs, cell_of)
-        if scenario == "find_return":  # only the red pillar in view: hide the green one
-            env.physics.show_objects(env.physics.object_ids([find_return.GREEN_PILLAR.name])[1], False)
+        if hidden:  # only the measured object in view
+            env.physics.show_objects(env.physics.object_ids(hidden)[1], False)
         results = []
         for distance in sorted(poses)[:3]:
             row, col, angle = poses[distance]
             spawn = (*(c * UNITS for c in config.cell_centre((row, col))), angle)
             doom, doom_mask = doom_view(textmap(config, spawn, things_of(config)), weapon=False)
-            ours, our_mask = mjmaze_view(env, spawn, objects)
+            ours, our_mask = mjmaze_view(env, spawn, [name])
             results.append(f"{distance}: {mean_colour(doom, doom_mask)} | {mean_colour(ours, our_mask)}")
         print(f"  {label}: " + "   ".join(results))
         env.task.close()
