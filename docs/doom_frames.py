@@ -2,6 +2,7 @@
 
     python docs/doom_frames.py              # docs/doom_vs_mjmaze.png: the Labyrinth exit from 1-3 cells
     python docs/doom_frames.py --calibrate  # colours of walls, floor, ceiling and objects, both engines
+    python docs/doom_frames.py --flashes    # ViZDoom's red (hurt) and gold (pickup) flashes, tic by tic
 
 Needs ViZDoom (``pip install -e ".[bench]"``; it draws Freedoom's textures and
 sprites, as the paper's runs did). The Doom map of an mjmaze maze is built the
@@ -40,6 +41,7 @@ RAISE_TICS = 8  # the pistol is still being raised for ~6 tics after the release
 STONE = ("STONE2", "FLAT1_1", "MFLR8_1")  # Labyrinth, Find-and-return, K-item
 SLIME = ("GSTONE1", "NUKAGE1", "CEIL4_1")  # Two-colour
 GREEN_ARMOUR, BLUE_ARMOUR, GREEN_COLUMN, RED_COLUMN = 2018, 2019, 30, 32
+LAVA_HEFTY = 83  # the sector special the released Two-colour generator writes (create_sector_toxic)
 # K-item's things in collection order, as the released generator places them (docs/objects.md).
 K_ITEM_THINGS = ((GREEN_ARMOUR, "green armour"), (BLUE_ARMOUR, "blue armour"), (2012, "medikit"),
                  (2013, "soulsphere"), (13, "red keycard"), (5, "blue keycard"))
@@ -57,7 +59,7 @@ class Thing:
 
 
 def textmap(config: configs.MazeConfig, spawn: tuple[float, float, int], things: list[Thing],
-            textures: tuple[str, str, str] = STONE) -> str:
+            textures: tuple[str, str, str] = STONE, special: int = 0) -> str:
     """The UDMF map of ``config``'s walls, laid out as the released generators write theirs."""
     n, cell = config.size, config.cell_size * UNITS
     half = n / 2 * cell
@@ -83,7 +85,7 @@ def textmap(config: configs.MazeConfig, spawn: tuple[float, float, int], things:
             v1, v2 = 4 * p + k, 4 * p + (k + 1) % 4
             lines.append(f"linedef {{ v1={v1}; v2={v2}; sidefront={v1}; blocking=true; }}")
             lines.append(f'sidedef {{ sector=0; texturemiddle="{wall}"; }}')
-    lines.append(f'sector {{ texturefloor="{floor}"; textureceiling="{ceiling}"; heightceiling=128; }}')
+    lines.append(f'sector {{ texturefloor="{floor}"; textureceiling="{ceiling}"; heightceiling=128; special={special}; }}')
     return "\n".join(lines) + "\n"
 
 
@@ -293,6 +295,47 @@ def calibrate() -> None:
     env.task.close()
 
 
+def flashes() -> None:
+    """Prints ViZDoom's full-screen flashes, tic by tic, in Two-colour's room.
+
+    The released generator gives Two-colour's one sector special 83 (ZDoom's
+    Damage_LavaHefty: 8 health every 32 tics), the health decay; Doom tints the
+    whole frame red when the player is hurt and gold when it picks something up.
+    The agent walks onto a blue armour 100 units ahead (armour then halves the
+    lava's damage). The ceiling patch is a flat (0, 0, 17) without a flash: its
+    red channel over 255 is the red flash's opacity.
+    """
+    import vizdoom as vzd
+
+    env = empty_arena("slime")
+    text = textmap(env.task.config, (0.0, 0.0, 0), [Thing(100.0, 0.0, BLUE_ARMOUR)], SLIME, special=LAVA_HEFTY)
+    env.task.close()
+    with tempfile.TemporaryDirectory() as folder:
+        wad = pathlib.Path(folder) / "maze.wad"
+        write_wad(wad, text)
+        game = vzd.DoomGame()
+        game.set_doom_scenario_path(str(wad))
+        game.set_screen_resolution(vzd.ScreenResolution.RES_320X180)
+        game.set_screen_format(vzd.ScreenFormat.RGB24)
+        game.set_render_hud(False)
+        game.set_window_visible(False)
+        game.set_sound_enabled(False)
+        game.set_episode_start_time(10)
+        game.set_available_buttons([vzd.Button.MOVE_FORWARD])
+        game.set_available_game_variables([vzd.GameVariable.HEALTH, vzd.GameVariable.ARMOR])
+        game.init()
+        game.new_episode()
+        print("tic  health armour  frame mean  ceiling patch")
+        for tic in range(70):
+            state = game.get_state()
+            frame = area_resize(state.screen_buffer)
+            health, armour = state.game_variables.astype(int)
+            print(f"{tic:3d}  {health:6d} {armour:6d}  {mean_colour(frame, (slice(None), slice(None)))}  "
+                  f"{mean_colour(frame, CEILING_BAND)}")
+            game.make_action([tic >= 30], 1)  # stand, then walk onto the armour
+        game.close()
+
+
 def cell_xy(config: configs.MazeConfig, cell: tuple[int, int]) -> tuple[float, float]:
     return tuple(c * UNITS for c in config.cell_centre(cell))
 
@@ -300,7 +343,11 @@ def cell_xy(config: configs.MazeConfig, cell: tuple[int, int]) -> tuple[float, f
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--calibrate", action="store_true", help="print colours instead of drawing the figure")
-    if parser.parse_args().calibrate:
+    parser.add_argument("--flashes", action="store_true", help="print the hurt and pickup flashes, tic by tic")
+    args = parser.parse_args()
+    if args.flashes:
+        flashes()
+    elif args.calibrate:
         calibrate()
     else:
         exit_figure()
