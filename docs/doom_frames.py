@@ -112,31 +112,38 @@ def area_resize(frame: np.ndarray, size: tuple[int, int] = SIZE) -> np.ndarray:
     return out / weight.reshape(weight.shape + (1,) * (frame.ndim - 2))
 
 
-def doom_view(text: str, weapon: bool = True) -> tuple[np.ndarray, np.ndarray]:
-    """ViZDoom's 112x64 frame of map ``text`` and the share of each pixel covered by things."""
+def released_game(wad: pathlib.Path, weapon: bool = True, variables=()):
+    """A ViZDoom game on ``wad``'s MAP01 with the released settings, its episode started."""
     import vizdoom as vzd
 
+    game = vzd.DoomGame()
+    game.set_doom_scenario_path(str(wad))
+    game.set_doom_map("map01")
+    game.set_screen_resolution(vzd.ScreenResolution.RES_320X180)
+    game.set_screen_format(vzd.ScreenFormat.RGB24)
+    game.set_render_hud(False)
+    game.set_render_crosshair(False)
+    game.set_render_weapon(weapon)
+    game.set_render_decals(False)
+    game.set_render_particles(False)
+    game.set_labels_buffer_enabled(True)
+    game.set_window_visible(False)
+    game.set_sound_enabled(False)
+    game.set_episode_start_time(10)  # as the released cfg
+    game.set_available_buttons([vzd.Button.MOVE_FORWARD])
+    game.set_available_game_variables(list(variables))
+    game.set_doom_skill(5)
+    game.init()
+    game.new_episode()
+    return game
+
+
+def doom_view(text: str, weapon: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """ViZDoom's 112x64 frame of map ``text`` and the share of each pixel covered by things."""
     with tempfile.TemporaryDirectory() as folder:
         wad = pathlib.Path(folder) / "maze.wad"
         write_wad(wad, text)
-        game = vzd.DoomGame()
-        game.set_doom_scenario_path(str(wad))
-        game.set_doom_map("map01")
-        game.set_screen_resolution(vzd.ScreenResolution.RES_320X180)
-        game.set_screen_format(vzd.ScreenFormat.RGB24)
-        game.set_render_hud(False)
-        game.set_render_crosshair(False)
-        game.set_render_weapon(weapon)
-        game.set_render_decals(False)
-        game.set_render_particles(False)
-        game.set_labels_buffer_enabled(True)
-        game.set_window_visible(False)
-        game.set_sound_enabled(False)
-        game.set_episode_start_time(10)  # as the released cfg
-        game.set_available_buttons([vzd.Button.MOVE_FORWARD])
-        game.set_doom_skill(5)
-        game.init()
-        game.new_episode()
+        game = released_game(wad, weapon)
         game.advance_action(RAISE_TICS)
         # Armour blinks (a plain frame 6 tics, a bright one 7): average a whole cycle.
         screens, masks = [], []
@@ -313,18 +320,8 @@ def flashes() -> None:
     with tempfile.TemporaryDirectory() as folder:
         wad = pathlib.Path(folder) / "maze.wad"
         write_wad(wad, text)
-        game = vzd.DoomGame()
-        game.set_doom_scenario_path(str(wad))
-        game.set_screen_resolution(vzd.ScreenResolution.RES_320X180)
-        game.set_screen_format(vzd.ScreenFormat.RGB24)
-        game.set_render_hud(False)
-        game.set_window_visible(False)
-        game.set_sound_enabled(False)
-        game.set_episode_start_time(10)
-        game.set_available_buttons([vzd.Button.MOVE_FORWARD])
-        game.set_available_game_variables([vzd.GameVariable.HEALTH, vzd.GameVariable.ARMOR])
-        game.init()
-        game.new_episode()
+        game = released_game(wad, weapon=True,
+                             variables=[vzd.GameVariable.HEALTH, vzd.GameVariable.ARMOR])
         print("tic  health armour  frame mean  ceiling patch")
         for tic in range(70):
             state = game.get_state()
