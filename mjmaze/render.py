@@ -67,6 +67,17 @@ def pistol_pixels(width: int, height: int) -> tuple[np.ndarray, np.ndarray, np.n
     return np.concatenate(rows), np.concatenate(cols), np.concatenate(colours)
 
 
+def tint(xp, frames, rgb, alpha):
+    """``frames`` (uint8 ``(..., H, W, 3)``) under a full-screen tint: ``rgb`` ``(..., 3)`` at opacity ``alpha`` ``(...)``.
+
+    Doom's flashes (:func:`mjmaze.rules.flash`), on numpy frames or torch
+    batches alike; returns new uint8 frames, rounded as GL blends.
+    """
+    alpha = xp.astype(alpha, xp.float32)[..., None, None, None]
+    over = (xp.astype(rgb, xp.float32) * alpha[..., 0, 0, :])[..., None, None, :]
+    return xp.astype(xp.floor(xp.astype(frames, xp.float32) * (1 - alpha) + over + 0.5), xp.uint8)
+
+
 class GLBackendError(RuntimeError):
     """No headless OpenGL backend could be started."""
 

@@ -47,7 +47,7 @@ from gymnasium.vector.utils import batch_space
 import mujoco_warp as mjw
 import warp as wp
 from mjmaze import mjcf, rules, suite
-from mjmaze.render import pistol_boxes
+from mjmaze.render import pistol_boxes, tint
 from mjmaze.tasks import base
 
 # Where a geom that must not be seen or touched in a world goes (below the floor).
@@ -237,7 +237,7 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         # The pistol over each frame, as the CPU renderer draws it (mjmaze.render.PISTOL).
         self._pistol = [
             (rows, cols, torch.as_tensor(rgb, device=dev))
-            for rows, cols, rgb in (pistol_boxes(width, height) if task.visual_style == "textured" else [])
+            for rows, cols, rgb in (pistol_boxes(width, height) if task.draws_pistol else [])
         ]
         self._stream = wp.stream_from_torch(torch.cuda.current_stream(dev)) if dev.type == "cuda" else None
 
@@ -398,9 +398,12 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         if self.task.head_bob and self._pistol:
             self._draw_swayed_pistol(torch.round(pistol_dx * self.task.width).long(),
                                      torch.round(pistol_dy * self.task.height).long())
-            return
-        for rows, cols, rgb in self._pistol:
-            self._obs[:, rows, cols] = rgb
+        else:
+            for rows, cols, rgb in self._pistol:
+                self._obs[:, rows, cols] = rgb
+        if self.task.flashes:  # every world, flashed or not: picking the flashed ones out would wait on the GPU
+            rgb, alpha = rules.flash(self.xp, self.state["damage_count"], self.state["bonus_count"])
+            self._obs.copy_(tint(self.xp, self._obs, rgb, alpha))
 
     def _draw_swayed_pistol(self, dx: torch.Tensor, dy: torch.Tensor) -> None:
         """The pistol's boxes, each env's shifted by its own ``(dx, dy)`` pixels (as :func:`mjmaze.render.pistol_boxes`)."""

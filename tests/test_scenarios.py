@@ -207,16 +207,23 @@ def test_pool_covers_a_full_episode():
     assert env.task.metrics()["duration"] == 2100
 
 
-def test_health_decays_and_reaching_zero_ends_the_episode():
+def test_the_floor_takes_8_health_every_32_tics_and_reaching_zero_ends_the_episode():
+    # As ViZDoom plays the released maze (python docs/doom_frames.py --flashes):
+    # 92 at the first frame, 84 from tic 23, 76 from tic 55, ...
     env = load("two_colour", complexity=5)
-    for step in range(1, 101):
+    assert env.task.health == 92
+    health = {}
+    for step in range(1, 95):
         timestep = env.step(TURN_LEFT)  # spinning never touches an item
-        if step < 100:
+        health[step * 4] = env.task.health
+        if step < 94:
             assert timestep.mid() and timestep.reward == pytest.approx(0.04)
+    assert (health[20], health[24], health[52], health[56]) == (92, 84, 84, 76)
+    # The 12th hit (tic 23 + 11 x 32 = 375) empties it.
     assert timestep.last() and timestep.discount == 0.0
     assert timestep.reward == 0.0  # the last step was not survived
     info = env.task.get_info(env.physics)
-    assert (info["health"], info["duration"]) == (0, 400)
+    assert (info["health"], info["duration"]) == (92 - 12 * 8, 376)
 
 
 def _lone_item(task, green):
@@ -236,15 +243,15 @@ def pick(env, green):
 def test_correct_item_raises_health_and_pays_wrong_one_costs_health():
     env = load("two_colour", complexity=1)
     task = env.task
-    env.step(TURN_LEFT)  # health 99
+    assert task.health == 92  # the floor's first 8 are taken; its next hit is 23 tics in (step 6)
     timestep = pick(env, task.totem_green)
-    assert task.health == 100 - 1  # +25 capped at 100, then the step's decay
+    assert task.health == 100  # +25 capped at 100
     assert timestep.reward == pytest.approx(0.04 + 1.0)
     timestep = pick(env, not task.totem_green)
-    assert task.health == 99 - 25 - 1
+    assert task.health == 75
     assert timestep.reward == pytest.approx(0.04)
     timestep = pick(env, task.totem_green)
-    assert task.health == 73 + 25 - 1
+    assert task.health == 100
     assert timestep.reward == pytest.approx(0.04 + 1.0)
 
 
@@ -255,6 +262,7 @@ def test_no_item_reward_at_full_health_and_the_reward_is_an_argument():
     task.health = 100
     timestep = pick(env, task.totem_green)
     assert timestep.reward == pytest.approx(0.04)  # health could not rise
+    task.health = 99
     timestep = pick(env, task.totem_green)
     assert timestep.reward == pytest.approx(0.04 + 0.1)
 

@@ -108,7 +108,8 @@ def test_a_run_asking_for_a_gpu_ray_lacks_is_one_clear_error(tmp_path):
 def test_a_run_folder_with_other_settings_is_refused_and_left_alone(tmp_path):
     run = tmp_path / "evidence" / "labyrinth_size7_s0"
     run.mkdir(parents=True)
-    saved = json.dumps({"scenario": "labyrinth", "size": 7, "num_envs": 16, "num_steps": 128})  # before head-bob
+    saved = json.dumps({"scenario": "labyrinth", "size": 7, "num_envs": 16, "num_steps": 128,
+                        "flashes": True})  # before head-bob
     (run / "config.json").write_text(saved)
     with pytest.raises(SystemExit, match="other settings \\(head_bob: saved False vs now True\\); move it aside"):
         sweep.main(["--grid", "evidence", "--only", "labyrinth_size7_s0", "--sweeps-dir", str(tmp_path)])

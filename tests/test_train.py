@@ -7,7 +7,7 @@ import pytest
 import torch
 
 from mjmaze.train import settings as run_settings
-from mjmaze.train import a2c, checkpoint, evaluate
+from mjmaze.train import a2c, checkpoint, evaluate, policy
 from mjmaze.train.model import Agent
 
 
@@ -149,15 +149,22 @@ def test_a_checkpoint_of_another_run_is_refused(tmp_path):
     assert latest.read_bytes() == before
 
 
-def test_a_checkpoint_from_before_head_bob_resumes_only_without_it(tmp_path):
-    run = a2c.train(tiny(tmp_path, head_bob=False))
+def test_a_run_from_before_head_bob_and_flashes_resumes_and_plays_only_without_them(tmp_path):
+    run = a2c.train(tiny(tmp_path, head_bob=False, flashes=False))
     latest = checkpoint.checkpoints(run / "checkpoints")[-1]
     state = torch.load(latest, weights_only=True)
-    del state["config"]["head_bob"]  # as saved before the setting existed
+    for key in ("head_bob", "flashes"):  # as saved before the settings existed
+        del state["config"][key]
     torch.save(state, latest)
-    assert checkpoint.load(latest, {**state["config"], "head_bob": False})["step"] == state["step"]
+    config = json.loads((run / "config.json").read_text())
+    (run / "config.json").write_text(json.dumps({k: v for k, v in config.items() if k not in ("head_bob", "flashes")}))
+    assert checkpoint.load(latest, {**state["config"], "head_bob": False, "flashes": False})["step"] == state["step"]
     with pytest.raises(checkpoint.CheckpointError, match="head_bob: checkpoint False vs now True"):
-        checkpoint.load(latest, {**state["config"], "head_bob": True})
+        checkpoint.load(latest, {**state["config"], "head_bob": True, "flashes": False})
+    with pytest.raises(checkpoint.CheckpointError, match="flashes: checkpoint False vs now True"):
+        checkpoint.load(latest, {**state["config"], "head_bob": False, "flashes": True})
+    args, _, _ = policy.load_run(run)  # evaluation and analysis play it as it was trained
+    assert (args.head_bob, args.flashes) == (False, False)
 
 
 def test_flags_for_another_scenario_are_refused():

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import mjmaze
-from mjmaze import mjcf, registry, render, suite
+from mjmaze import mjcf, registry, render, rules, suite
 from mjmaze.tasks import base
 
 torch = pytest.importorskip("torch")
@@ -138,6 +138,24 @@ def test_head_bob_moves_each_worlds_eye_and_pistol_as_the_cpu_task():
             assert np.array_equal((obs[i].numpy() == hand).all(-1), (frame == hand).all(-1)), (step, i)
             swing = max(swing, abs(eyes[i] - mjcf.EYE_HEIGHT))
     assert swing > 0.03  # the eyes did bob (by up to 8 map units, 6 cm)
+
+
+def test_flashes_tint_every_world_as_the_cpu_task():
+    # Two-colour's floor hurts at tic 23 (step 6): counts 6 then 2, red over each world's frame.
+    kwargs = {"complexity": 1}
+    flashed, plain = (mjwarp.MazeBatchEnv(2, "two_colour", device="cpu", flashes=f, **kwargs) for f in (True, False))
+    for env in (flashed, plain):
+        env.reset(seed=SEED)
+    for step in range(1, 9):
+        actions = torch.tensor([0, 1])  # spin in place: no item is touched
+        obs, _, _, _, info = flashed.step(actions)
+        obs_plain, *_ = plain.step(actions)
+        damage = {6: 6, 7: 2}.get(step, 0)
+        assert flashed.state["damage_count"].tolist() == [damage, damage], step
+        assert info["health"].tolist() == [92 if step < 6 else 84] * 2
+        rgb, alpha = rules.flash(flashed.xp, flashed.state["damage_count"], flashed.state["bonus_count"])
+        assert torch.equal(obs, render.tint(flashed.xp, obs_plain, rgb, alpha)), step
+        assert torch.equal(obs, obs_plain) == (damage == 0), step
 
 
 def test_a_released_layout_that_spawns_inside_the_totem(tmp_path):

@@ -16,16 +16,20 @@ from mjmaze.files import atomic_write
 
 PREFIX, SUFFIX = "step_", ".pt"
 # What must agree between a checkpoint and the run that loads it.
-IDENTITY_KEYS = ("scenario", "size", "num_items", "complexity", "num_envs", "num_steps", "head_bob")
+IDENTITY_KEYS = ("scenario", "size", "num_items", "complexity", "num_envs", "num_steps", "head_bob", "flashes")
 # Settings that runs saved before they existed ran with.
-MISSING_MEANS = {"head_bob": False}
+MISSING_MEANS = {"head_bob": False, "flashes": False}
+
+
+def setting_of(config: dict, key: str):
+    """A run config's value of ``key``; for a run saved before the setting existed, what it ran with."""
+    return config.get(key, MISSING_MEANS.get(key))
 
 
 def identity_differences(saved: dict, now: dict) -> dict:
     """``{key: (saved value, value now)}`` of the :data:`IDENTITY_KEYS` that differ between two run configs."""
-    def value(config, key):
-        return config.get(key, MISSING_MEANS.get(key))
-    return {k: (value(saved, k), value(now, k)) for k in IDENTITY_KEYS if value(saved, k) != value(now, k)}
+    return {k: (setting_of(saved, k), setting_of(now, k)) for k in IDENTITY_KEYS
+            if setting_of(saved, k) != setting_of(now, k)}
 
 
 class CheckpointError(RuntimeError):

@@ -71,9 +71,9 @@ def evaluate_checkpoints(run_dir: pathlib.Path, num_envs: int = 16) -> None:
 
 def group_key(config: dict) -> tuple:
     """What makes runs seeds of one curve: the scenario, its difficulty, the number of training configurations,
-    and what the agent saw (head-bob; runs saved before it existed ran without)."""
+    and what the agent saw (head-bob, flashes; runs saved before they existed ran without)."""
     return (config["scenario"], config.get("size"), config.get("num_items"), config.get("complexity"),
-            config.get("num_configs"), config.get("head_bob", checkpoint.MISSING_MEANS["head_bob"]))
+            config.get("num_configs"), checkpoint.setting_of(config, "head_bob"), checkpoint.setting_of(config, "flashes"))
 
 
 def setting(config: dict) -> str:
@@ -86,9 +86,10 @@ def setting(config: dict) -> str:
 
 
 def label(config: dict) -> str:
-    """The setting, and what set this group's frames apart (no head-bob)."""
-    no_bob = not config.get("head_bob", checkpoint.MISSING_MEANS["head_bob"])
-    return setting(config) + (" (no head-bob)" if no_bob else "")
+    """The setting, and what set this group's frames apart (no head-bob, no flashes)."""
+    missing = [name for key, name in (("head_bob", "head-bob"), ("flashes", "flashes"))
+               if not checkpoint.setting_of(config, key)]
+    return setting(config) + (f" (no {', no '.join(missing)})" if missing else "")
 
 
 def binned(runs: list[dict], bins: int) -> dict:

@@ -34,7 +34,8 @@ def load_run(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | 
     config_file = run_dir / "config.json"
     if not config_file.exists():
         raise FileNotFoundError(f"{run_dir} is not a training run (no config.json)")
-    args = Args(**json.loads(config_file.read_text()))
+    # A run saved before a setting existed ran without it (checkpoint.MISSING_MEANS).
+    args = Args(**{**checkpoint.MISSING_MEANS, **json.loads(config_file.read_text())})
     if checkpoint_path is None:
         found = checkpoint.checkpoints(run_dir / "checkpoints")
         if not found:

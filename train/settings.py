@@ -51,6 +51,8 @@ class _RunSettings:
     """auto (CUDA when available), cpu or cuda"""
     head_bob: bool = True
     """Doom's head-bob while walking (the eye swings, the pistol sways); --no-head-bob keeps the view still"""
+    flashes: bool = True
+    """Doom's full-screen flashes (red when hurt, gold on a pickup); --no-flashes leaves the view untinted"""
     backend: str = "cpu"
     """where the envs run: cpu (worker processes) or warp (every env in one MuJoCo Warp model on --device, beside the network; pip install "mjmaze[warp]")"""
     torch_threads: int | None = None
@@ -80,6 +82,8 @@ class _RunSettings:
             kwargs["num_configs"] = self.num_configs
         if not self.head_bob:
             kwargs["head_bob"] = False
+        if not self.flashes:
+            kwargs["flashes"] = False
         return kwargs
 
     def name(self) -> str:

@@ -193,6 +193,8 @@ class MazeTask(base.Task):
     scenario: str = ""
     #: The colours of its walls, floor and ceiling (the released Doom textures').
     room: mjcf.Room = mjcf.STONE_ROOM
+    #: Whether the released runs saw the pistol (their .cfg's ``render_weapon``): drawn in the "textured" style.
+    pistol: bool = True
 
     def __init__(
         self,
@@ -208,6 +210,7 @@ class MazeTask(base.Task):
         layouts: str | os.PathLike | None = None,
         visual_style: str = "textured",
         head_bob: bool = True,
+        flashes: bool = True,
         random=None,
     ):
         super().__init__(random=random)
@@ -218,6 +221,11 @@ class MazeTask(base.Task):
             raise ValueError(f"head_bob must be True or False, got {head_bob!r}")
         #: Doom's head-bob while walking: the eye swings, the pistol sways (:func:`view_bob`).
         self.head_bob = bool(head_bob)
+        if not isinstance(flashes, (bool, np.bool_)):
+            raise ValueError(f"flashes must be True or False, got {flashes!r}")
+        #: Doom's full-screen flashes: red when hurt, gold on a pickup (:func:`mjmaze.rules.flash`).
+        self.flashes = bool(flashes)
+        self._tints: dict[tuple[int, int], tuple[np.ndarray, float]] = {}
         _check_choice("split", split, configs.SPLITS)
         _check_choice("config_sampling", config_sampling, configs.CONFIG_SAMPLING)
         _check_choice("action_set", action_set, tuple(ACTION_SETS))
@@ -273,10 +281,7 @@ class MazeTask(base.Task):
         self._model, self._bound_data = model, data
         self._qpos, self._qvel = data.qpos, data.qvel
         self._walls = mjcf.WallLayout(model, self.layout.grid_size, self.layout.cell_size)
-        # The pistol belongs to the paper's look ("textured"), not to the cheap "flat" one.
-        self._renderer = render.EgoRenderer(
-            model, CAMERA, self.width, self.height, pistol=self.visual_style == "textured"
-        )
+        self._renderer = render.EgoRenderer(model, CAMERA, self.width, self.height, pistol=self.draws_pistol)
         self._eye = model.cam(CAMERA).pos  # a view into the model: head-bob moves it
         fovy = math.radians(model.cam(CAMERA).fovy[0])
         self.horizontal_fov = 2 * math.atan(math.tan(fovy / 2) * self.width / self.height)
@@ -403,6 +408,9 @@ class MazeTask(base.Task):
         state["key"] = keys
         state["steps"] = xp.zeros(keys.shape, dtype=xp.int64, device=rules.device(keys))
         state["episode_return"] = xp.zeros(keys.shape, dtype=xp.float64, device=rules.device(keys))
+        # Doom's flash counters (mjmaze.rules.flash); a scenario's rules set them.
+        for name in ("damage_count", "bonus_count"):
+            state.setdefault(name, xp.zeros(keys.shape, dtype=xp.int64, device=rules.device(keys)))
         return state
 
     def step_state(self, xp, state: dict, path) -> tuple:
@@ -441,6 +449,14 @@ class MazeTask(base.Task):
     def get_observation(self, physics: MazePhysics) -> collections.OrderedDict:
         self._bind(physics)
         frame = self._renderer.render(self._bound_data, pistol_shift=self._bob_view(physics))
+        if self.flashes:
+            damage, bonus = self.state["damage_count"][self.row], self.state["bonus_count"][self.row]
+            if damage or bonus:  # most frames have no flash: no work for them
+                tint = self._tints.get((damage, bonus))
+                if tint is None:  # a few dozen pairs occur: each worked out once
+                    rgb, alpha = rules.flash(np, np.array([damage]), np.array([bonus]))
+                    tint = self._tints[int(damage), int(bonus)] = rgb[0], alpha[0]
+                frame[...] = render.tint(np, frame, *tint)
         if self.observation_buffer is None:
             return collections.OrderedDict(pixels=frame.copy())
         np.copyto(self.observation_buffer, frame)
@@ -481,6 +497,11 @@ class MazeTask(base.Task):
         return collections.OrderedDict(
             pixels=specs.Array((self.height, self.width, 3), np.uint8, name="pixels")
         )
+
+    @property
+    def draws_pistol(self) -> bool:
+        """Whether frames show the pistol: where the released runs did, in the paper's look ("textured")."""
+        return self.pistol and self.visual_style == "textured"
 
     @property
     def action_names(self) -> tuple[str, ...]:

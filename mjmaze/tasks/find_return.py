@@ -73,10 +73,13 @@ class FindReturn(base.MazeTask):
     def rules(self, xp, state, path):
         # The pillars stand in different cells, more than a step apart: one
         # step never touches both, so target and return are checked in turn.
-        green, red = state["object_xy"][:, 0], state["object_xy"][:, 1]
         found = state["target_found"]
-        target = ~found & rules.touched(xp, red, path)
-        returned = found & rules.touched(xp, green, path)
+        tic = rules.first_tic(xp, state["object_xy"], path)  # (B, 2): the green pillar's, the red's
+        # The target is an invisible armour (as released): taking it flashes the view gold.
+        target_tic = xp.where(found, -1, tic[:, 1])
+        target = target_tic >= 0
+        state["bonus_count"] = rules.bonus_after_step(xp, state["bonus_count"], target_tic, path.shape[1])
+        returned = found & (tic[:, 0] >= 0)
         state["target_found"] = found | target
         state["success"] = state["success"] | returned
         reward = STEP_REWARD + TARGET_REWARD * xp.astype(target, xp.float64) + RETURN_REWARD * xp.astype(returned, xp.float64)

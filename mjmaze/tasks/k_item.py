@@ -92,9 +92,12 @@ class KItem(base.MazeTask):
     def rules(self, xp, state, path):
         # Items are in cells 1.25 m apart: one step (at most 0.27 m) reaches at most
         # one of them, at any of its tics.
-        reached = rules.reached(xp, state["object_xy"], path) & state["object_shown"]
+        tic = xp.where(state["object_shown"], rules.first_tic(xp, state["object_xy"], path), -1)
+        reached = tic >= 0
         is_next = rules.one_hot(xp, state["next"], self.num_items)
         correct = xp.any(reached & is_next, axis=1)
+        # Every item is a Doom pickup (as released): taking one flashes the view gold.
+        state["bonus_count"] = rules.bonus_after_step(xp, state["bonus_count"], xp.max(tic, axis=1), path.shape[1])
         wrong = ~correct & xp.any(reached, axis=1)
         state["object_shown"] = state["object_shown"] & ~(is_next & correct[:, None])
         state["next"] = state["next"] + xp.astype(correct, xp.int64)

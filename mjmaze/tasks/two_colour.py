@@ -9,9 +9,13 @@ Rules
     and 10 red items start at random positions, uniform over the floor the agent
     can stand on (as released) and out of its reach; one more appears every 30
     tics, colours alternating, with no cap (as released; at most 90 in an
-    episode, a fixed pool of 90 geoms). Health starts at 100 (cap 100): an item
-    of the totem's colour gives +25, the other colour takes 25, and health decays
-    by 1 per agent step (released: 8 every 32 tics).
+    episode, a fixed pool of 90 geoms). Health (cap 100) decays as the released
+    maze's floor takes it, Doom's hefty lava: 8 every 32 tics, the first hit
+    already taken at the first observation (health 92), the next 23 tics in,
+    as ViZDoom plays it. An item of the totem's colour gives +25, the other
+    colour takes 25. **Decision**: the released decay, where the paper's spec
+    reads 1 per agent step (README, "Decisions"); each hit flashes the view red
+    (:func:`mjmaze.rules.flash`), every item gold.
 Rewards
     +0.01 per tic survived (+0.04 per agent step) and ``correct_item_reward``
     (default +1.0) whenever a correct item raises health (so nothing at full
@@ -20,6 +24,7 @@ Rewards
 Termination
     Health <= 0 (discount 0) or 525 agent steps (discount 1).
 Arguments
+    No pistol is drawn: the released Two-colour .cfg has ``render_weapon = false``.
     ``complexity`` c in 0..10 (paper: 1, 3, 5, 7; each interior wall is kept with
     probability c/10), ``correct_item_reward``, ``item_cap`` (None = no cap, as
     released) and the common task arguments. The spawn heading is fixed at 0
@@ -46,9 +51,16 @@ CELL_SIZE = 2.0
 START_ITEMS_PER_COLOUR = 10
 SPAWN_EVERY_TICS = 30
 POOL_SIZE = 2 * START_ITEMS_PER_COLOUR + (base.EPISODE_STEPS * base.TICS_PER_STEP) // SPAWN_EVERY_TICS  # 90
-START_HEALTH = MAX_HEALTH = 100
+MAX_HEALTH = 100
 ITEM_HEALTH = 25
-HEALTH_DECAY_PER_STEP = 1
+# The released maze's floor is ZDoom's Damage_LavaHefty (sector special 83): 8
+# health when the level's time is a multiple of 32 tics. ViZDoom's first
+# observation is 9 tics into the level, so the first hit has landed (health
+# 92) and the next comes 23 tics in (measured: python docs/doom_frames.py --flashes).
+LAVA_DAMAGE = 8
+LAVA_EVERY_TICS = 32
+LAVA_FIRST_TIC = 23
+START_HEALTH = MAX_HEALTH - LAVA_DAMAGE
 SURVIVAL_REWARD = 0.01 * base.TICS_PER_STEP
 CORRECT_ITEM_REWARD = 1.0
 # Items appear uniformly where the agent can stand: at least its radius from
@@ -84,6 +96,7 @@ class TwoColour(base.MazeTask):
 
     scenario = "two_colour"
     room = mjcf.SLIME_ROOM
+    pistol = False  # the released .cfg: render_weapon = false
     objects = (TOTEM, *ITEMS)
 
     def __init__(
@@ -155,22 +168,41 @@ class TwoColour(base.MazeTask):
 
     def rules(self, xp, state, path):
         shown, health, totem_green = state["object_shown"], state["health"], state["totem_green"]
+        device, tics = rules.device(health), path.shape[1]
         first_tic = xp.where(shown[:, 1:], rules.first_tic(xp, state["object_xy"][:, 1:], path), -1)
         picked = first_tic >= 0
-        # Items in the order the agent reached them (Doom tests every tic),
-        # then by index: health is capped, so the order matters.
-        index = xp.arange(POOL_SIZE, dtype=xp.int64, device=rules.device(health))
-        order = xp.argsort(xp.where(picked, first_tic * POOL_SIZE + index, _NEVER), axis=1, stable=True)
-        num_picked = xp.sum(xp.astype(picked, xp.int64), axis=1)
-        reward = xp.zeros(health.shape, dtype=xp.float64, device=rules.device(health))
-        for rank in range(int(xp.max(num_picked))):
-            item = order[:, rank]
-            taken = rank < num_picked
-            correct = taken & ((item % 2 == 0) == totem_green)  # even items are green
+        # The step's events, in the order Doom takes them: by tic, and within a
+        # tic the floor's hit before the items (by index). Health is capped,
+        # so the order matters. Event 0 is the lava, event 1 + k item k.
+        before = (state["steps"] - 1) * base.TICS_PER_STEP  # tics played before this step
+        lava_tic = (LAVA_FIRST_TIC - 1 - before) % LAVA_EVERY_TICS  # this step's tic index of the next hit
+        event_tic = xp.concat([xp.where(lava_tic < tics, lava_tic, -1)[:, None], first_tic], axis=1)
+        index = xp.arange(1 + POOL_SIZE, dtype=xp.int64, device=device)
+        order = xp.argsort(xp.where(event_tic >= 0, event_tic * (1 + POOL_SIZE) + index, _NEVER), axis=1, stable=True)
+        num_events = xp.sum(xp.astype(event_tic >= 0, xp.int64), axis=1)
+        reward = xp.zeros(health.shape, dtype=xp.float64, device=device)
+        # Doom's damage count (the red flash), followed tic by tic through the events:
+        # a count settled at the end of tic ``settled``.
+        damage, settled = state["damage_count"], xp.full(health.shape, -1, dtype=xp.int64, device=device)
+        for rank in range(int(xp.max(num_events))):
+            event = order[:, rank]
+            tic = xp.take_along_axis(event_tic, event[:, None], axis=1)[:, 0]
+            happens = (rank < num_events) & (health > 0)  # nothing reaches a dead agent
+            lava = happens & (event == 0)
+            correct = happens & (event > 0) & ((event % 2 == 1) == totem_green)  # even items (odd events) are green
+            wrong = happens & (event > 0) & ~correct
             raised = xp.minimum(health + ITEM_HEALTH, MAX_HEALTH)
             reward = reward + self._correct_item_reward * xp.astype(correct & (raised > health), xp.float64)
-            health = xp.where(correct, raised, xp.where(taken & ~correct, health - ITEM_HEALTH, health))
-        health = health - HEALTH_DECAY_PER_STEP
+            hurt = lava | wrong
+            hit = xp.where(lava, LAVA_DAMAGE, xp.where(wrong, ITEM_HEALTH, 0))
+            health = xp.where(correct, raised, health - hit)
+            # Lava hurts before the tic's count-down, an item's damage after it.
+            before_count = xp.astype(lava, xp.int64)
+            counted = rules.count_down(xp, damage, tic - settled - before_count)
+            damage = xp.where(hurt, xp.minimum(counted + hit, rules.MAX_DAMAGE_COUNT) - before_count, damage)
+            settled = xp.where(hurt, tic, settled)
+        state["damage_count"] = rules.count_down(xp, damage, tics - 1 - settled)
+        state["bonus_count"] = rules.bonus_after_step(xp, state["bonus_count"], xp.max(first_tic, axis=1), tics)
         dead = health <= 0
         state["health"] = health
         shown = xp.concat([shown[:, :1], shown[:, 1:] & ~picked], axis=1)

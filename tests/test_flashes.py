@@ -1,0 +1,129 @@
+"""Doom's full-screen flashes: red when the agent is hurt, gold when it picks something up.
+
+Each scenario is played beside a twin with ``flashes=False`` (same seed, same
+moves): the frames must differ by exactly the tint, and only where Doom flashes.
+Counts and opacities are ViZDoom's (docs/look.md, ``python docs/doom_frames.py --flashes``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import mjmaze
+from mjmaze import render, rules
+from mjmaze.tasks import two_colour
+
+from conftest import TURN_LEFT, place
+
+
+def twins(name, **kwargs):
+    envs = [mjmaze.load(name, task_kwargs={"random": 0, "flashes": flashes, **kwargs}) for flashes in (True, False)]
+    for env in envs:
+        env.reset()
+    return envs
+
+
+def step_both(envs, action=TURN_LEFT, xy=None):
+    """One step of both twins (from ``xy`` facing +x if given); returns (flashed frame, plain frame)."""
+    frames = []
+    for env in envs:
+        if xy is not None:
+            place(env, xy[0], xy[1], 0.0)
+        frames.append(env.step(action).observation["pixels"].astype(int))
+    return frames
+
+
+def tinted(frame, damage, bonus):
+    rgb, alpha = rules.flash(np, np.array([damage]), np.array([bonus]))
+    return render.tint(np, frame.astype(np.uint8), rgb[0], alpha[0]).astype(int)
+
+
+def counts(env):
+    return int(env.task.state["damage_count"][0]), int(env.task.state["bonus_count"][0])
+
+
+def test_the_opacities_are_zdooms():
+    # Lava's 8, on its first frame (7): ViZDoom's ceiling turned (46, 0, 13) from (0, 0, 17).
+    rgb, alpha = rules.flash(np, np.array([7, 0, 25, 100]), np.array([0, 6, 0, 0]))
+    assert alpha * 255 == pytest.approx([47, 48, 115, 0.5 * 255])  # red, gold, a wrong item, the cap
+    assert rgb[0] == pytest.approx(rules.DAMAGE_RGB) and rgb[1] == pytest.approx(rules.BONUS_RGB)
+    # Both at once: ZDoom lays the gold over the red.
+    rgb, alpha = rules.flash(np, np.array([7]), np.array([6]))
+    gold, red = 48 / 255, 47 / 255
+    assert alpha[0] == pytest.approx(gold + (1 - gold) * red)
+    assert rgb[0] == pytest.approx((gold * np.array(rules.BONUS_RGB) + (1 - gold) * red * np.array(rules.DAMAGE_RGB))
+                                   / alpha[0])
+    frame = np.full((2, 2, 3), (15, 21, 15), dtype=np.uint8)
+    rgb, alpha = rules.flash(np, np.array([7]), np.array([0]))
+    # ViZDoom's mean frame went from (15, 21, 15) to (58, 16-17, 11): within a level.
+    assert render.tint(np, frame, rgb[0], alpha[0])[0, 0].tolist() == pytest.approx([58, 17, 11], abs=1)
+
+
+def test_each_lava_hit_flashes_the_view_red_for_two_steps():
+    envs = twins("two_colour", complexity=1)
+    for step in range(1, 17):
+        flashed, plain = step_both(envs)
+        # Hits at tics 23 and 55 (steps 6 and 14): counts 8 - 1 - 1 = 6 and 2 at the next step's end.
+        expected = {6: 6, 7: 2, 14: 6, 15: 2}.get(step, 0)
+        assert counts(envs[0]) == (expected, 0), step
+        assert np.array_equal(flashed, tinted(plain, expected, 0) if expected else plain), step
+
+
+def _lone_item(task, green):
+    active = np.flatnonzero(task.item_active & (task.item_green == green))
+    everyone = np.flatnonzero(task.item_active)
+    for k in active:
+        others = everyone[everyone != k]
+        if (np.linalg.norm(task.item_xy[others] - task.item_xy[k], axis=1) > 0.7).all():
+            return task.item_xy[k].copy()
+    raise AssertionError("no isolated item")
+
+
+def test_a_wrong_item_flashes_red_and_gold_a_right_one_gold():
+    envs = twins("two_colour", complexity=1)
+    task = envs[0].task
+    # Standing on it at the step's first tic: 3 more tics count down before the frame.
+    flashed, plain = step_both(envs, xy=_lone_item(task, not task.totem_green))
+    assert task.health == 92 - two_colour.ITEM_HEALTH
+    assert counts(envs[0]) == (25 - 3, 6 - 3)
+    assert np.array_equal(flashed, tinted(plain, 22, 3))
+    flashed, plain = step_both(envs, xy=_lone_item(task, task.totem_green))
+    assert task.health == 92
+    assert counts(envs[0]) == (22 - 4, 6 - 3)  # healing does not flash red; the red fades on
+    assert np.array_equal(flashed, tinted(plain, 18, 3))
+
+
+def test_the_find_and_return_target_flashes_gold_once():
+    envs = twins("find_return", size=5)
+    config = envs[0].task.config
+    red = config.cell_centre(config.object_cells[0])
+    flashed, plain = step_both(envs, xy=(red[0] - 0.2, red[1]))
+    assert envs[0].task.metrics()["target_found"] and counts(envs[0]) == (0, 3)
+    assert np.array_equal(flashed, tinted(plain, 0, 3))
+    flashed, plain = step_both(envs, xy=(red[0] - 0.2, red[1]))  # found already: no new flash, it fades out
+    assert counts(envs[0]) == (0, 0) and np.array_equal(flashed, plain)
+
+
+def test_a_k_item_pickup_flashes_gold():
+    envs = twins("k_item", num_items=4)
+    config = envs[0].task.config
+    first = config.cell_centre(config.object_cells[0])
+    flashed, plain = step_both(envs, xy=(first[0] - 0.2, first[1]))
+    assert counts(envs[0]) == (0, 3)
+    assert np.array_equal(flashed, tinted(plain, 0, 3))
+
+
+def test_labyrinth_never_flashes_and_two_colour_draws_no_pistol():
+    hand = render.pistol_boxes(1, 1)[1][2]
+    for name, kwargs, pistol in (("labyrinth", {"size": 5}, True), ("two_colour", {"complexity": 1}, False)):
+        flashed, plain = step_both(twins(name, **kwargs))
+        if name == "labyrinth":
+            assert np.array_equal(flashed, plain)
+        # The released Two-colour .cfg: render_weapon = false.
+        assert (plain == hand).all(-1).any() == pistol, name
+
+
+def test_flashes_must_be_a_bool():
+    with pytest.raises(ValueError, match="flashes must be True or False"):
+        mjmaze.load("labyrinth", task_kwargs={"flashes": "yes"})
