@@ -36,7 +36,9 @@ FORWARD, TURN_LEFT = 2, 0
 def open_room(head_bob=None, width=320, height=180):
     """A 10 m room without inner walls or items, the agent at its south end facing north, clear of the totem."""
     bob = {} if head_bob is None else {"head_bob": head_bob}  # None: the default
-    task = two_colour.TwoColour(complexity=0, item_cap=0, width=width, height=height, random=0, **bob)
+    # ViZDoom's probe room had the pistol and no damaging floor: no flashes, the pistol drawn.
+    task = two_colour.TwoColour(complexity=0, item_cap=0, width=width, height=height, random=0, flashes=False, **bob)
+    task.pistol = True
     env = base.make_environment(task)
     env.reset()
     # ViZDoom's start was (0, -500) facing 90 in the same room without the totem (at the centre here).
