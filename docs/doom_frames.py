@@ -225,8 +225,9 @@ def empty_arena(room: str):
     """An empty 10 m arena (Two-colour at complexity 0) coloured as ``room``, its objects hidden."""
     from mjmaze import mjcf
 
-    task = two_colour.TwoColour(complexity=0, item_cap=0)
+    task = two_colour.TwoColour(complexity=0, item_cap=0, flashes=False)
     task.room = {"stone": mjcf.STONE_ROOM, "slime": mjcf.SLIME_ROOM}[room]
+    task.pistol = True  # the ViZDoom probes beside it draw the pistol (released_game's weapon)
     env = base.make_environment(task)
     env.reset()
     env.physics.show_objects(env.physics.object_ids([o.name for o in task.objects])[1], False)
