@@ -3,7 +3,8 @@
 Action Space
     ``DiscreteArray(5)`` (``action_set="extended"``: 8), as in Labyrinth.
 Observation
-    ``pixels``: uint8 RGB ``(64, 112, 3)``.
+    ``pixels``: uint8 RGB ``(64, 112, 3)``, without the pistol (the released
+    Two-colour .cfg has ``render_weapon = false``).
 Rules
     A tall totem at the maze centre is red or green, 50/50 per episode. 10 green
     and 10 red items start at random positions, uniform over the floor the agent
@@ -24,7 +25,6 @@ Rewards
 Termination
     Health <= 0 (discount 0) or 525 agent steps (discount 1).
 Arguments
-    No pistol is drawn: the released Two-colour .cfg has ``render_weapon = false``.
     ``complexity`` c in 0..10 (paper: 1, 3, 5, 7; each interior wall is kept with
     probability c/10), ``correct_item_reward``, ``item_cap`` (None = no cap, as
     released) and the common task arguments. The spawn heading is fixed at 0
