@@ -120,13 +120,13 @@ BONUS_TICS = 6  # Doom's BONUSADD
 MAX_DAMAGE_COUNT = 100
 DAMAGE_RGB = (255, 0, 0)
 BONUS_RGB = (215, 186, 69)
-# ZDoom's red opacity (of 255) for a damage count: a log scale, capped at 175.
+# ZDoom's red opacity (of 255) for a damage count: a log scale, capped at 175
+# (the table stops where the cap takes over).
 DAMAGE_TO_ALPHA = (
     0, 8, 16, 23, 30, 36, 42, 47, 53, 58, 62, 67, 71, 75, 79, 83, 87, 90, 94, 97, 100, 103, 107, 109, 112, 115,
     118, 120, 123, 125, 128, 130, 133, 135, 137, 139, 141, 143, 145, 147, 149, 151, 153, 155, 157, 159, 160, 162,
     164, 165, 167, 169, 170, 172, 173, 175,
 )  # the table goes on to 113 -> 237, all above the cap
-MAX_DAMAGE_ALPHA = 175
 MAX_FLASH_ALPHA = 0.5  # ZDoom keeps at least half of the view
 
 

@@ -450,12 +450,12 @@ class MazeTask(base.Task):
         self._bind(physics)
         frame = self._renderer.render(self._bound_data, pistol_shift=self._bob_view(physics))
         if self.flashes:
-            damage, bonus = self.state["damage_count"][self.row], self.state["bonus_count"][self.row]
-            if damage or bonus:  # most frames have no flash: no work for them
-                tint = self._tints.get((damage, bonus))
+            counts = int(self.state["damage_count"][self.row]), int(self.state["bonus_count"][self.row])
+            if any(counts):  # most frames have no flash: no work for them
+                tint = self._tints.get(counts)
                 if tint is None:  # a few dozen pairs occur: each worked out once
-                    rgb, alpha = rules.flash(np, np.array([damage]), np.array([bonus]))
-                    tint = self._tints[int(damage), int(bonus)] = rgb[0], alpha[0]
+                    rgb, alpha = rules.flash(np, np.array(counts[:1]), np.array(counts[1:]))
+                    tint = self._tints[counts] = rgb[0], alpha[0]
                 frame[...] = render.tint(np, frame, *tint)
         if self.observation_buffer is None:
             return collections.OrderedDict(pixels=frame.copy())
