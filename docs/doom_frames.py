@@ -3,6 +3,8 @@
     python docs/doom_frames.py              # docs/doom_vs_mjmaze.png: the Labyrinth exit from 1-3 cells
     python docs/doom_frames.py --calibrate  # colours of walls, floor, ceiling and objects, both engines
     python docs/doom_frames.py --flashes    # ViZDoom's red (hurt) and gold (pickup) flashes, tic by tic
+    python docs/doom_frames.py --two-colour RELEASED_REPO/scenarios/basefiles/two_color_basefile.wad
+                                            # the released Two-colour script played: health changes, tics survived
 
 Needs ViZDoom (``pip install -e ".[bench]"``; it draws Freedoom's textures and
 sprites, as the paper's runs did). The Doom map of an mjmaze maze is built the
@@ -56,11 +58,17 @@ class Thing:
     x: float  # map units
     y: float
     type: int
+    tid: int = 0  # the id scripts find it by (0: none)
 
 
 def textmap(config: configs.MazeConfig, spawn: tuple[float, float, int], things: list[Thing],
-            textures: tuple[str, str, str] = STONE, special: int = 0) -> str:
-    """The UDMF map of ``config``'s walls, laid out as the released generators write theirs."""
+            textures: tuple[str, str, str] = STONE, special: int = 0, origin: float = 0.0) -> str:
+    """The UDMF map of ``config``'s walls, laid out as the released generators write theirs.
+
+    ``origin`` (map units) shifts the maze: mjmaze centres it on (0, 0), the
+    released Two-colour generator on (-cell / 2, -cell / 2), where its script
+    spawns the items. ``spawn`` and ``things`` are not shifted.
+    """
     n, cell = config.size, config.cell_size * UNITS
     half = n / 2 * cell
     low = -half
@@ -78,9 +86,9 @@ def textmap(config: configs.MazeConfig, spawn: tuple[float, float, int], things:
     wall, floor, ceiling = textures
     flags = "coop=true; dm=true; single=true; skill1=true; skill2=true; skill3=true; skill4=true; skill5=true;"
     lines = ['namespace="zdoom";', f"thing {{ x={spawn[0]:.3f}; y={spawn[1]:.3f}; angle={spawn[2]}; type=1; {flags} }}"]
-    lines += [f"thing {{ x={t.x:.3f}; y={t.y:.3f}; type={t.type}; {flags} }}" for t in things]
+    lines += [f"thing {{ x={t.x:.3f}; y={t.y:.3f}; type={t.type}; id={t.tid}; {flags} }}" for t in things]
     for p, polygon in enumerate(polygons):
-        lines += [f"vertex {{ x={vx:.3f}; y={vy:.3f}; }}" for vx, vy in polygon]
+        lines += [f"vertex {{ x={vx + origin:.3f}; y={vy + origin:.3f}; }}" for vx, vy in polygon]
         for k in range(4):
             v1, v2 = 4 * p + k, 4 * p + (k + 1) % 4
             lines.append(f"linedef {{ v1={v1}; v2={v2}; sidefront={v1}; blocking=true; }}")
@@ -89,9 +97,22 @@ def textmap(config: configs.MazeConfig, spawn: tuple[float, float, int], things:
     return "\n".join(lines) + "\n"
 
 
-def write_wad(path: pathlib.Path, text: str) -> None:
-    """A PWAD holding MAP01 as UDMF (ZDoom builds the nodes when it loads the map)."""
-    lumps = [(b"MAP01", b""), (b"TEXTMAP", text.encode()), (b"ENDMAP", b"")]
+def read_lumps(wad: pathlib.Path) -> dict[bytes, bytes]:
+    """A WAD's lumps by name."""
+    data = wad.read_bytes()
+    count, directory = struct.unpack("<ii", data[4:12])
+    lumps = {}
+    for k in range(count):
+        offset, size, name = struct.unpack("<ii8s", data[directory + 16 * k : directory + 16 * (k + 1)])
+        lumps[name.rstrip(b"\0")] = data[offset : offset + size]
+    return lumps
+
+
+def write_wad(path: pathlib.Path, text: str, behavior: bytes | None = None) -> None:
+    """A PWAD holding MAP01 as UDMF (ZDoom builds the nodes when it loads the map), with compiled ACS if given."""
+    lumps = [(b"MAP01", b""), (b"TEXTMAP", text.encode())]
+    lumps += [(b"BEHAVIOR", behavior)] if behavior is not None else []
+    lumps += [(b"ENDMAP", b"")]
     data, directory, offset = b"", b"", 12
     for name, body in lumps:
         directory += struct.pack("<ii8s", offset, len(body), name)
@@ -112,7 +133,7 @@ def area_resize(frame: np.ndarray, size: tuple[int, int] = SIZE) -> np.ndarray:
     return out / weight.reshape(weight.shape + (1,) * (frame.ndim - 2))
 
 
-def released_game(wad: pathlib.Path, weapon: bool = True, variables=()):
+def released_game(wad: pathlib.Path, weapon: bool = True, variables=(), buttons=None):
     """A ViZDoom game on ``wad``'s MAP01 with the released settings, its episode started."""
     import vizdoom as vzd
 
@@ -130,7 +151,7 @@ def released_game(wad: pathlib.Path, weapon: bool = True, variables=()):
     game.set_window_visible(False)
     game.set_sound_enabled(False)
     game.set_episode_start_time(10)  # as the released cfg
-    game.set_available_buttons([vzd.Button.MOVE_FORWARD])
+    game.set_available_buttons(buttons or [vzd.Button.MOVE_FORWARD])
     game.set_available_game_variables(list(variables))
     game.set_doom_skill(5)
     game.init()
@@ -334,6 +355,59 @@ def flashes() -> None:
         game.close()
 
 
+def two_colour_script(basefile: pathlib.Path, episodes: int = 32, complexity: int = 1) -> None:
+    """Plays the released Two-colour script (its compiled ACS, from ``basefile``) on mjmaze's mazes.
+
+    Each of ``episodes`` training mazes is laid out as the released generator
+    lays its own (centred on the totem's spot, the script's map spots, the
+    hefty-lava floor), and a uniformly random policy over the 5 actions plays
+    it with frame skip 4, as an env step. Prints every change of health by its
+    size (lava 8, a right item +25 up to the cap, wrong ones 25 less what the
+    armour picked up absorbs) and the tics survived: the figures
+    ``mjmaze.tasks.two_colour`` holds, and a random policy's level in ViZDoom.
+    """
+    import collections
+
+    import vizdoom as vzd
+
+    behavior = read_lumps(basefile)[b"BEHAVIOR"]
+    buttons = [vzd.Button.TURN_LEFT, vzd.Button.TURN_RIGHT, vzd.Button.MOVE_FORWARD]
+    actions = [[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [0, 1, 1]]  # mjmaze's default set, in its order
+    rng = np.random.default_rng(0)
+    env = mjmaze.load("two_colour", task_kwargs={"complexity": complexity, "random": 0})
+    changes, survived = collections.Counter(), []
+    with tempfile.TemporaryDirectory() as folder:
+        for episode in range(episodes):
+            env.reset()
+            config = env.task.config
+            origin = -config.cell_size * UNITS / 2  # the released maze spans [-768, 512] units
+            spawn = tuple(c * UNITS + origin for c in config.cell_centre(config.spawn_cell))
+            totem = tuple(c * UNITS + origin for c in config.cell_centre(config.object_cells[0]))
+            # The script moves one of two columns parked outside the map onto map spot 10.
+            things = [Thing(-4096.0, 0.0, GREEN_COLUMN, 11), Thing(-4000.0, 0.0, RED_COLUMN, 12),
+                      Thing(*totem, 9001, 10)]
+            wad = pathlib.Path(folder) / f"two_colour_{episode}.wad"
+            write_wad(wad, textmap(config, (*spawn, 0), things, SLIME, LAVA_HEFTY, origin), behavior)
+            game = released_game(wad, weapon=False, variables=[vzd.GameVariable.HEALTH], buttons=buttons)
+            health, tics = game.get_game_variable(vzd.GameVariable.HEALTH), 0
+            while not game.is_episode_finished() and tics < 2100:
+                action = actions[rng.integers(len(actions))]
+                for _ in range(4):  # tic by tic, so that each change is seen alone
+                    game.make_action(action, 1)
+                    tics += 1
+                    if game.is_episode_finished():
+                        break
+                    now = game.get_game_variable(vzd.GameVariable.HEALTH)
+                    if now != health:
+                        changes[int(now - health)] += 1
+                    health = now
+            game.close()
+            survived.append(tics)
+    env.task.close()
+    print(f"health changes (size: count) over {episodes} episodes: {dict(sorted(changes.items()))}")
+    print(f"tics survived by a random policy: {np.mean(survived):.0f} (std {np.std(survived):.0f})")
+
+
 def cell_xy(config: configs.MazeConfig, cell: tuple[int, int]) -> tuple[float, float]:
     return tuple(c * UNITS for c in config.cell_centre(cell))
 
@@ -342,8 +416,13 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--calibrate", action="store_true", help="print colours instead of drawing the figure")
     parser.add_argument("--flashes", action="store_true", help="print the hurt and pickup flashes, tic by tic")
+    parser.add_argument("--two-colour", type=pathlib.Path, metavar="BASEFILE_WAD",
+                        help="play the released Two-colour script (two_color_basefile.wad of the released repo)")
+    parser.add_argument("--episodes", type=int, default=32, help="episodes for --two-colour")
     args = parser.parse_args()
-    if args.flashes:
+    if args.two_colour:
+        two_colour_script(args.two_colour, args.episodes)
+    elif args.flashes:
         flashes()
     elif args.calibrate:
         calibrate()

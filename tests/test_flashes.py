@@ -85,13 +85,14 @@ def test_a_wrong_item_flashes_red_and_gold_a_right_one_gold():
     task = envs[0].task
     # Standing on it at the step's first tic: 3 more tics count down before the frame.
     flashed, plain = step_both(envs, xy=_lone_item(task, not task.totem_green))
-    assert task.health == 92 - two_colour.ITEM_HEALTH
-    assert counts(envs[0]) == (25 - 3, 6 - 3)
-    assert np.array_equal(flashed, tinted(plain, 22, 3))
+    damage = two_colour.WRONG_RED_DAMAGE if task.totem_green else two_colour.WRONG_GREEN_DAMAGE
+    assert task.health == 92 - damage
+    assert counts(envs[0]) == (damage - 3, 6 - 3)  # the count is the damage the armour let through
+    assert np.array_equal(flashed, tinted(plain, damage - 3, 3))
     flashed, plain = step_both(envs, xy=_lone_item(task, task.totem_green))
-    assert task.health == 92
-    assert counts(envs[0]) == (22 - 4, 6 - 3)  # healing does not flash red; the red fades on
-    assert np.array_equal(flashed, tinted(plain, 18, 3))
+    assert task.health == min(92 - damage + two_colour.ITEM_HEALTH, 100)
+    assert counts(envs[0]) == (damage - 3 - 4, 6 - 3)  # healing does not flash red; the red fades on
+    assert np.array_equal(flashed, tinted(plain, damage - 7, 3))
 
 
 def test_the_find_and_return_target_flashes_gold_once():

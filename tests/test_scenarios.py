@@ -248,11 +248,25 @@ def test_correct_item_raises_health_and_pays_wrong_one_costs_health():
     assert task.health == 100  # +25 capped at 100
     assert timestep.reward == pytest.approx(0.04 + 1.0)
     timestep = pick(env, not task.totem_green)
-    assert task.health == 75
+    assert task.health < 100
     assert timestep.reward == pytest.approx(0.04)
     timestep = pick(env, task.totem_green)
     assert task.health == 100
     assert timestep.reward == pytest.approx(0.04 + 1.0)
+
+
+def test_a_wrong_item_costs_25_less_what_its_armour_absorbs():
+    # As ViZDoom plays the released script: the armour is picked up before
+    # Thing_Damage(25), so the green armour (33%) leaves 17, the red one (50%) 13.
+    env = load("two_colour", complexity=1)
+    task, cost = env.task, {}
+    while len(cost) < 2:
+        env.reset()
+        task.health = 100
+        pick(env, not task.totem_green)
+        cost["red" if task.totem_green else "green"] = 100 - task.health
+    assert cost == {"green": 17, "red": 13}
+    assert (two_colour.WRONG_GREEN_DAMAGE, two_colour.WRONG_RED_DAMAGE) == (17, 13)
 
 
 def test_no_item_reward_at_full_health_and_the_reward_is_an_argument():

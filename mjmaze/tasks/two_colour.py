@@ -13,9 +13,11 @@ Rules
     episode, a fixed pool of 90 geoms). Health (cap 100) decays as the released
     maze's floor takes it, Doom's hefty lava: 8 every 32 tics, the first hit
     already taken at the first observation (health 92), the next 23 tics in,
-    as ViZDoom plays it. An item of the totem's colour gives +25, the other
-    colour takes 25. **Decision**: the released decay, where the paper's spec
-    reads 1 per agent step (README, "Decisions"); each hit flashes the view red
+    as ViZDoom plays it. An item of the totem's colour gives +25; the other
+    colour takes 25 less what the armour just picked up absorbs: 17 for a
+    green item, 13 for a red one. **Decision**: the released decay and
+    damage, where the paper's spec reads 1 per agent step and 25
+    (README, "Decisions"); each hit flashes the view red
     (:func:`mjmaze.rules.flash`), every item gold.
 Rewards
     +0.01 per tic survived (+0.04 per agent step) and ``correct_item_reward``
@@ -53,6 +55,14 @@ SPAWN_EVERY_TICS = 30
 POOL_SIZE = 2 * START_ITEMS_PER_COLOUR + (base.EPISODE_STEPS * base.TICS_PER_STEP) // SPAWN_EVERY_TICS  # 90
 MAX_HEALTH = 100
 ITEM_HEALTH = 25
+# The released script hands over the armour first, then takes 25 with
+# Thing_Damage and clears the inventory: the armour just picked up absorbs
+# its share (ZDoom: int(damage x SavePercent), 33.335% for the green armour,
+# 50% for the "blue" one drawn red), so a wrong green item costs 17 and a
+# wrong red one 13, while a right one gives 25 (measured in ViZDoom:
+# python docs/doom_frames.py --two-colour RELEASED_WAD).
+WRONG_GREEN_DAMAGE = ITEM_HEALTH - int(ITEM_HEALTH * 0.33335)
+WRONG_RED_DAMAGE = ITEM_HEALTH - int(ITEM_HEALTH * 0.5)
 # The released maze's floor is ZDoom's Damage_LavaHefty (sector special 83): 8
 # health when the level's time is a multiple of 32 tics. ViZDoom's first
 # observation is 9 tics into the level, so the first hit has landed (health
@@ -184,6 +194,8 @@ class TwoColour(base.MazeTask):
         # Doom's damage count (the red flash), followed tic by tic through the events:
         # a count settled at the end of tic ``settled``.
         damage, settled = state["damage_count"], xp.full(health.shape, -1, dtype=xp.int64, device=device)
+        # A wrong item is the colour the totem is not.
+        wrong_damage = xp.where(totem_green, WRONG_RED_DAMAGE, WRONG_GREEN_DAMAGE)
         for rank in range(int(xp.max(num_events))):
             event = order[:, rank]
             tic = xp.take_along_axis(event_tic, event[:, None], axis=1)[:, 0]
@@ -194,7 +206,7 @@ class TwoColour(base.MazeTask):
             raised = xp.minimum(health + ITEM_HEALTH, MAX_HEALTH)
             reward = reward + self._correct_item_reward * xp.astype(correct & (raised > health), xp.float64)
             hurt = lava | wrong
-            hit = xp.where(lava, LAVA_DAMAGE, xp.where(wrong, ITEM_HEALTH, 0))
+            hit = xp.where(lava, LAVA_DAMAGE, xp.where(wrong, wrong_damage, 0))
             health = xp.where(correct, raised, health - hit)
             # Lava hurts before the tic's count-down, an item's damage after it.
             before_count = xp.astype(lava, xp.int64)
