@@ -1,9 +1,13 @@
 """Right and wrong items a Two-colour run's policy picks up per episode.
 
     python docs/two_colour_items.py RUN CHECKPOINT {greedy,sample,uniform} EPISODES
+    python docs/two_colour_items.py scripted {any,right} EPISODES [COMPLEXITY]
 
 Plays test mazes (env seed 1) in one dm_control env and counts the items that
 leave the floor, by colour against the totem's: whether the policy tells them apart.
+``scripted`` plays a policy that sees through walls instead: it steers for the
+nearest item (``any`` colour, or only the ``right`` one), what a learned policy
+could reach for with colour-blind and with totem-aware sight.
 """
 
 from __future__ import annotations
@@ -17,12 +21,52 @@ import mjmaze
 from mjmaze.train import policy
 
 
+TURN_LEFT, TURN_RIGHT, FORWARD, FORWARD_LEFT, FORWARD_RIGHT = range(5)
+
+
+class Seeker:
+    """Steers for the nearest item on the floor (of the totem's colour only if ``right_only``)."""
+
+    def __init__(self, env, right_only: bool, seed: int = 0):
+        self.env, self.right_only = env, right_only
+        self.rng = np.random.default_rng(seed)
+        self.last_xy, self.stuck = None, 0
+
+    def reset(self) -> None:
+        self.last_xy, self.stuck = None, 0
+
+    def act(self, pixels) -> int:
+        task = self.env.task
+        x, y, yaw = self.env.physics.agent_pose()
+        wanted = task.item_active & ((task.item_green == task.totem_green) | (not self.right_only))
+        moved = self.last_xy is None or np.hypot(x - self.last_xy[0], y - self.last_xy[1]) > 0.02
+        self.stuck = 0 if moved else self.stuck + 1
+        self.last_xy = (x, y)
+        if not wanted.any() or self.stuck >= 2:  # nothing to reach, or against a wall: a random step
+            return int(self.rng.integers(5))
+        targets = task.item_xy[wanted]
+        dx, dy = (targets - (x, y)).T
+        k = int(np.argmin(dx * dx + dy * dy))
+        error = (np.arctan2(dy[k], dx[k]) - yaw + np.pi) % (2 * np.pi) - np.pi
+        if abs(error) > np.radians(30):
+            return TURN_LEFT if error > 0 else TURN_RIGHT
+        if abs(error) > np.radians(8):
+            return FORWARD_LEFT if error > 0 else FORWARD_RIGHT
+        return FORWARD
+
+
 def main() -> None:
-    run, checkpoint_path, mode, episodes = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4])
-    torch.set_num_threads(1)
-    args, agent, _ = policy.load_run(run, checkpoint_path)
-    env = mjmaze.load("two_colour", task_kwargs={**args.task_kwargs(), "split": "test", "random": 1})
-    player = policy.Policy(agent, mode, seed=0)
+    if sys.argv[1] == "scripted":
+        kind, episodes = sys.argv[2], int(sys.argv[3])
+        complexity = int(sys.argv[4]) if len(sys.argv) > 4 else 1
+        env = mjmaze.load("two_colour", task_kwargs={"complexity": complexity, "split": "test", "random": 1})
+        player, mode = Seeker(env, right_only=kind == "right"), f"scripted, {kind} items"
+    else:
+        run, checkpoint_path, mode, episodes = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4])
+        torch.set_num_threads(1)
+        args, agent, _ = policy.load_run(run, checkpoint_path)
+        env = mjmaze.load("two_colour", task_kwargs={**args.task_kwargs(), "split": "test", "random": 1})
+        player = policy.Policy(agent, mode, seed=0)
     right = wrong = 0
     durations = []
     for _ in range(episodes):
