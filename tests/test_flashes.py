@@ -45,8 +45,8 @@ def counts(env):
 
 def test_the_opacities_are_zdooms():
     # Lava's 8, on its first frame (7): ViZDoom's ceiling turned (46, 0, 13) from (0, 0, 17).
-    rgb, alpha = rules.flash(np, np.array([7, 0, 25, 100]), np.array([0, 6, 0, 0]))
-    assert alpha * 255 == pytest.approx([47, 48, 115, 0.5 * 255])  # red, gold, a wrong item, the cap
+    rgb, alpha = rules.flash(np, np.array([7, 0, 17, 100]), np.array([0, 6, 0, 0]))
+    assert alpha * 255 == pytest.approx([47, 48, 90, 0.5 * 255])  # red, gold, a wrong green item, the cap
     assert rgb[0] == pytest.approx(rules.DAMAGE_RGB) and rgb[1] == pytest.approx(rules.BONUS_RGB)
     # Both at once: ZDoom lays the gold over the red.
     rgb, alpha = rules.flash(np, np.array([7]), np.array([6]))
