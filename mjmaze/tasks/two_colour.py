@@ -57,12 +57,13 @@ MAX_HEALTH = 100
 ITEM_HEALTH = 25
 # The released script hands over the armour first, then takes 25 with
 # Thing_Damage and clears the inventory: the armour just picked up absorbs
-# its share (ZDoom: int(damage x SavePercent), 33.335% for the green armour,
-# 50% for the "blue" one drawn red), so a wrong green item costs 17 and a
-# wrong red one 13, while a right one gives 25 (measured in ViZDoom:
+# its share (ZDoom: int(damage x SavePercent)), so a wrong green item costs
+# 17 and a wrong red one 13, while a right one gives 25 (measured in ViZDoom:
 # python docs/doom_frames.py --two-colour RELEASED_WAD).
-WRONG_GREEN_DAMAGE = ITEM_HEALTH - int(ITEM_HEALTH * 0.33335)
-WRONG_RED_DAMAGE = ITEM_HEALTH - int(ITEM_HEALTH * 0.5)
+GREEN_ARMOUR_SAVES = 0.33335  # Doom's GreenArmor SavePercent
+RED_ARMOUR_SAVES = 0.5  # BlueArmor's, the armour Freedoom draws red
+WRONG_GREEN_DAMAGE = ITEM_HEALTH - int(ITEM_HEALTH * GREEN_ARMOUR_SAVES)
+WRONG_RED_DAMAGE = ITEM_HEALTH - int(ITEM_HEALTH * RED_ARMOUR_SAVES)
 # The released maze's floor is ZDoom's Damage_LavaHefty (sector special 83): 8
 # health when the level's time is a multiple of 32 tics. ViZDoom's first
 # observation is 9 tics into the level, so the first hit has landed (health
