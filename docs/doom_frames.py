@@ -160,14 +160,15 @@ def released_game(wad: pathlib.Path, weapon: bool = True, variables=(), buttons=
     return game
 
 
-def doom_view(text: str, weapon: bool = True) -> tuple[np.ndarray, np.ndarray]:
-    """ViZDoom's 112x64 frame of map ``text`` and the share of each pixel covered by things."""
+def doom_tics(text: str, weapon: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """ViZDoom's 112x64 frames of map ``text``, one per tic of the armour's blink cycle, and per
+    frame the share of each pixel covered by things."""
     with tempfile.TemporaryDirectory() as folder:
         wad = pathlib.Path(folder) / "maze.wad"
         write_wad(wad, text)
         game = released_game(wad, weapon)
         game.advance_action(RAISE_TICS)
-        # Armour blinks (a plain frame 6 tics, a bright one 7): average a whole cycle.
+        # Armour blinks (a plain frame 6 tics, a bright one 7): a whole cycle.
         screens, masks = [], []
         for _ in range(ANIMATION_TICS):
             state = game.get_state()
@@ -176,7 +177,14 @@ def doom_view(text: str, weapon: bool = True) -> tuple[np.ndarray, np.ndarray]:
             masks.append(area_resize(np.isin(state.labels_buffer, things).astype(np.float64)))
             game.advance_action(1)
         game.close()
-    return np.mean(screens, axis=0).round().astype(np.uint8), np.mean(masks, axis=0)
+    return np.array(screens), np.array(masks)
+
+
+def doom_view(text: str, weapon: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """ViZDoom's 112x64 frame of map ``text`` and the share of each pixel covered by things,
+    averaged over the armour's blink cycle."""
+    screens, masks = doom_tics(text, weapon)
+    return screens.mean(axis=0).round().astype(np.uint8), masks.mean(axis=0)
 
 
 def mjmaze_view(env, spawn: tuple[float, float, int], objects: list[str]) -> tuple[np.ndarray, np.ndarray]:
@@ -334,26 +342,13 @@ def item_contrast() -> None:
     ViZDoom's are averaged over the armour's 13-tic blink, each tic against
     the empty room's same tic (the slime floor is animated).
     """
-    def doom_tics(text: str) -> np.ndarray:
-        with tempfile.TemporaryDirectory() as folder:
-            wad = pathlib.Path(folder) / "maze.wad"
-            write_wad(wad, text)
-            game = released_game(wad, weapon=False)
-            game.advance_action(RAISE_TICS)
-            frames = []
-            for _ in range(ANIMATION_TICS):
-                frames.append(area_resize(game.get_state().screen_buffer))
-                game.advance_action(1)
-            game.close()
-        return np.array(frames)
-
     def contrast(frame: np.ndarray, empty: np.ndarray) -> tuple[float, int]:
         difference = np.abs(frame.astype(np.float64) - empty.astype(np.float64)).sum(axis=-1)
         return difference.sum() / 255, int((difference > 60).sum())
 
     env = empty_arena("slime", pistol=False)
     config, physics = env.task.config, env.physics
-    empty_doom = doom_tics(textmap(config, (0.0, 0.0, 0), [], SLIME))
+    empty_doom, _ = doom_tics(textmap(config, (0.0, 0.0, 0), [], SLIME), weapon=False)
     empty_ours, _ = mjmaze_view(env, (0.0, 0.0, 0), [])
     print("Two-colour items d metres ahead: contrast mass, pixels changed by > 60 (Doom | mjmaze)")
     name = two_colour.ITEMS[0].name
@@ -364,7 +359,7 @@ def item_contrast() -> None:
         physics.show_objects(ids[1], True)
         results = []
         for d in (1, 2, 3, 4):
-            frames = doom_tics(textmap(config, (0.0, 0.0, 0), [Thing(d * UNITS, 0.0, doom_type)], SLIME))
+            frames, _ = doom_tics(textmap(config, (0.0, 0.0, 0), [Thing(d * UNITS, 0.0, doom_type)], SLIME), weapon=False)
             doom = np.mean([contrast(f, e) for f, e in zip(frames, empty_doom)], axis=0)
             physics.place_objects(ids[0], np.array([[d, 0.0]]))
             ours = contrast(mjmaze_view(env, (0.0, 0.0, 0), [name])[0], empty_ours)

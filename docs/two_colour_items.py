@@ -18,10 +18,12 @@ import numpy as np
 import torch
 
 import mjmaze
+from mjmaze.tasks import base
 from mjmaze.train import policy
 
 
-TURN_LEFT, TURN_RIGHT, FORWARD, FORWARD_LEFT, FORWARD_RIGHT = range(5)
+TURN_LEFT, TURN_RIGHT, FORWARD, FORWARD_LEFT, FORWARD_RIGHT = (
+    base.ACTION_NAMES.index(name) for name in ("turn_left", "turn_right", "forward", "forward_left", "forward_right"))
 
 
 class Seeker:
@@ -58,6 +60,8 @@ class Seeker:
 def main() -> None:
     if sys.argv[1] == "scripted":
         kind, episodes = sys.argv[2], int(sys.argv[3])
+        if kind not in ("any", "right"):
+            sys.exit(f"scripted takes 'any' or 'right' (which items to steer for), got {kind!r}")
         complexity = int(sys.argv[4]) if len(sys.argv) > 4 else 1
         env = mjmaze.load("two_colour", task_kwargs={"complexity": complexity, "split": "test", "random": 1})
         player, mode = Seeker(env, right_only=kind == "right"), f"scripted, {kind} items"
