@@ -359,7 +359,8 @@ def item_contrast() -> None:
         physics.show_objects(ids[1], True)
         results = []
         for d in (1, 2, 3, 4):
-            frames, _ = doom_tics(textmap(config, (0.0, 0.0, 0), [Thing(d * UNITS, 0.0, doom_type)], SLIME), weapon=False)
+            item_map = textmap(config, (0.0, 0.0, 0), [Thing(d * UNITS, 0.0, doom_type)], SLIME)
+            frames, _ = doom_tics(item_map, weapon=False)
             doom = np.mean([contrast(f, e) for f, e in zip(frames, empty_doom)], axis=0)
             physics.place_objects(ids[0], np.array([[d, 0.0]]))
             ours = contrast(mjmaze_view(env, (0.0, 0.0, 0), [name])[0], empty_ours)
