@@ -74,11 +74,29 @@ def test_hidden_state_analysis_of_a_random_policy_on_two_colour(tmp_path):
         assert isinstance(episode["totem_green"], bool)
         assert (states["totem_green"][states["episode"] == k] == episode["totem_green"]).all()
     assert summary["landmark"] == "totem"
+    assert "totem_probe" in summary  # None here: 3 short episodes are too few to cross-validate
     seen = [e["landmark_first_seen"] for e in summary["episodes"]]
     assert list(states["landmark_first_seen"]) == [-1 if s is None else s for s in seen]
     picture(out / "heatmap.png")
     two_panels = picture(out / "tsne.png")
     assert two_panels.shape[1] > 1.5 * two_panels.shape[0]  # the totem-colour panel beside the time panel
+
+
+def test_totem_probe_reads_the_colour_only_where_the_state_carries_it():
+    rng = np.random.default_rng(0)
+    episodes, length = 12, 30
+    episode_of = np.repeat(np.arange(episodes), length)
+    green = np.repeat(np.arange(episodes) % 2 == 0, length)
+    noise = rng.normal(size=(episodes * length, 16))
+    seen = np.ones(len(green), dtype=bool)
+    carried = noise.copy()
+    carried[:, 3] += np.where(green, 2.0, -2.0)  # one unit holds the colour
+    assert analysis.totem_probe(carried, green, episode_of, seen)["accuracy"] > 0.95
+    blind = analysis.totem_probe(noise, green, episode_of, seen)
+    assert blind["majority"] == 0.5 and blind["accuracy"] < 0.7
+    assert blind["episodes"] == episodes and blind["states"] == episodes * length and blind["folds"] == 5
+    # Only the states after the sighting count; one episode of a colour is too few to test across episodes.
+    assert analysis.totem_probe(carried, green, episode_of, episode_of < 3) is None
 
 
 def test_tsne_keeps_at_most_the_asked_number_of_states(tmp_path):

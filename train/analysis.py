@@ -16,7 +16,12 @@ configurations, records the GRU state after every frame, and writes into
   ``--tsne-states`` states drawn evenly from all episodes, coloured by time step,
   with up to 20 episodes drawn as lines; for Two-colour a second panel coloured
   by the totem's colour;
-- ``summary.json``: what was played and written.
+- ``summary.json``: what was played and written; for Two-colour also
+  ``totem_probe``: how well a linear read-out (scikit-learn's logistic
+  regression, cross-validated across episodes) tells the totem's colour from
+  the GRU state once the totem has been seen, beside the majority colour's
+  share. The policy can only act on the colour if its state carries it; run
+  it on the ``random`` agent too, whose untrained features carry some.
 
 ``random`` analyses an untrained agent acting uniformly at random: the baseline
 against which a trained agent's structure stands out.
@@ -38,6 +43,7 @@ from . import checkpoint, policy
 
 TSNE_STATES = 2000
 TSNE_LINES = 20
+PROBE_FOLDS = 5
 
 
 def record_states(source_args: argparse.Namespace, episodes: int, max_steps: int | None = None):
@@ -90,6 +96,30 @@ def tsne(states: np.ndarray, seed: int) -> np.ndarray:
 
     perplexity = float(min(30.0, max(2.0, (len(states) - 1) / 3)))
     return TSNE(n_components=2, perplexity=perplexity, init="pca", random_state=seed).fit_transform(states)
+
+
+def totem_probe(hidden: np.ndarray, totem_green: np.ndarray, episode_of: np.ndarray, seen: np.ndarray,
+                folds: int = PROBE_FOLDS, seed: int = 0) -> dict | None:
+    """Cross-validated accuracy of a linear read-out of the totem's colour from the states where ``seen``.
+
+    Folds split by episode (a state is never tested on a read-out fitted to its own
+    episode) and keep both colours in each; None when fewer than 2 episodes of
+    each colour saw the totem.
+    """
+    from sklearn.linear_model import LogisticRegression
+    from sklearn.model_selection import StratifiedGroupKFold, cross_val_score
+    from sklearn.pipeline import make_pipeline
+    from sklearn.preprocessing import StandardScaler
+
+    states, green, groups = hidden[seen], totem_green[seen], episode_of[seen]
+    episodes_per_colour = min(len(np.unique(groups[green == colour])) for colour in (False, True))
+    if episodes_per_colour < 2:
+        return None
+    splits = StratifiedGroupKFold(n_splits=min(folds, episodes_per_colour), shuffle=True, random_state=seed)
+    read_out = make_pipeline(StandardScaler(), LogisticRegression(max_iter=2000))
+    accuracy = cross_val_score(read_out, states, green, groups=groups, cv=splits)
+    return {"accuracy": float(accuracy.mean()), "majority": float(max(green.mean(), 1 - green.mean())),
+            "states": int(len(states)), "episodes": int(len(np.unique(groups))), "folds": int(len(accuracy))}
 
 
 def tsne_figure(embedding: np.ndarray, steps: np.ndarray, episode_of: np.ndarray, title: str,
@@ -154,11 +184,17 @@ def analyse(source_args: argparse.Namespace, episodes: int, out: pathlib.Path | 
     save_figure(tsne_figure(embedding, steps[chosen], episode_of[chosen], title,
                             None if totem_green is None else totem_green[chosen]), out / "tsne.png")
 
+    probe = None
+    if totem_green is not None:
+        seen = (first_seen[episode_of] >= 0) & (steps >= first_seen[episode_of])
+        probe = totem_probe(hidden, totem_green, episode_of, seen, seed=source_args.seed)
+
     field, scale, units = suite.paper_metric(scenario)
     summary = {
         "source": source_args.source, "description": description, "scenario": scenario, "task_kwargs": task_kwargs,
         "split": source_args.split, "states": len(hidden), "tsne_points": len(embedding),
         "landmark": registry.get(scenario).landmark, "metric_units": units, "heatmap_episode": heatmap_episode,
+        **({"totem_probe": probe} if totem_green is not None else {}),
         "episodes": [
             {"config_index": e.config_index, "length": e.length, "return": float(e.rewards.sum()),
              "metric": float(e.infos[-1][field]) * scale, "landmark_first_seen": e.landmark_first_seen,
@@ -187,6 +223,12 @@ def main(argv: list[str] | None = None) -> None:
     seen = [e["landmark_first_seen"] for e in summary["episodes"] if e["landmark_first_seen"] is not None]
     print(f"{summary['states']} states from {len(summary['episodes'])} episodes; t-SNE of {summary['tsne_points']}; "
           f"{summary['landmark']} seen in {len(seen)} episodes")
+    if "totem_probe" in summary:
+        probe = summary["totem_probe"]
+        print("totem's colour from the state once seen: " + (
+            "too few episodes of each colour saw the totem" if probe is None else
+            f"{probe['accuracy']:.1%} read out ({probe['folds']}-fold across {probe['episodes']} episodes, "
+            f"{probe['states']} states; majority colour {probe['majority']:.1%})"))
     print("written: " + ", ".join(summary["files"]))
 
 
