@@ -20,8 +20,8 @@ configurations, records the GRU state after every frame, and writes into
   ``totem_probe``: how well a linear read-out (scikit-learn's logistic
   regression, cross-validated across episodes) tells the totem's colour from
   the GRU state once the totem has been seen, beside the majority colour's
-  share. The policy can only act on the colour if its state carries it; run
-  it on the ``random`` agent too, whose untrained features carry some.
+  share. The policy can only act on the colour if its state carries it; the
+  ``random`` agent's untrained network gives the baseline.
 
 ``random`` analyses an untrained agent acting uniformly at random: the baseline
 against which a trained agent's structure stands out.
