@@ -186,7 +186,8 @@ def analyse(source_args: argparse.Namespace, episodes: int, out: pathlib.Path | 
 
     probe = None
     if totem_green is not None:
-        seen = (first_seen[episode_of] >= 0) & (steps >= first_seen[episode_of])
+        sighting = first_seen[episode_of]  # per state, its episode's first sighting (-1: never)
+        seen = (sighting >= 0) & (steps >= sighting)
         probe = totem_probe(hidden, totem_green, episode_of, seen, seed=source_args.seed)
 
     field, scale, units = suite.paper_metric(scenario)
