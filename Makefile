@@ -13,6 +13,11 @@ TEST_PACKAGES := xvfb xdotool
 # Installed only when no torch is there yet: install your own (a CUDA build,
 # say) into .venv first to train on a GPU.
 TORCH ?= torch==2.13.0
+# PyPI's Linux torch brings triton (torch 2.13.0 pins triton 3.7.1), and a
+# triton loaded after Mesa's LLVM once crashed every training script
+# (mjmaze/llvm_clash.py). `make test` adds it where torch came without it (this
+# box's CPU wheel), so the tests run as users install; `TRITON=` skips it.
+TRITON ?= triton==3.7.1
 # Where pip looks for torch; empty = PyPI (whose Linux torch is the multi-GB
 # CUDA build). Without an NVIDIA GPU: TORCH_INDEX=https://download.pytorch.org/whl/cpu
 TORCH_INDEX ?=
@@ -30,7 +35,7 @@ run: system-deps $(VENV)/.stamp-torch $(VENV)/.stamp-train,viz
 	  --run-name $(RUN_NAME) --checkpoint-every 250000
 	$(PY) -m mjmaze.train.evaluate runs/$(RUN_NAME)
 
-test: system-deps test-deps $(VENV)/.stamp-torch $(VENV)/.stamp-train,dev
+test: system-deps test-deps $(VENV)/.stamp-torch $(VENV)/.stamp-triton $(VENV)/.stamp-train,dev
 	$(PY) -m pytest -q
 
 bench: system-deps $(VENV)/.stamp-bench
@@ -70,6 +75,12 @@ $(VENV)/bin/python:
 
 $(VENV)/.stamp-torch: | $(VENV)/bin/python
 	$(PY) -c 'import torch' 2>/dev/null || $(PY) -m pip install -q $(if $(TORCH_INDEX),--index-url $(TORCH_INDEX)) "$(TORCH)"
+	@touch $@
+
+$(VENV)/.stamp-triton: $(VENV)/.stamp-torch
+	@if [ -n "$(TRITON)" ] && [ "$$(uname -s)" = Linux ] && \
+	  ! $(PY) -c 'import importlib.util, sys; sys.exit(importlib.util.find_spec("triton") is None)'; then \
+	  echo "Installing $(TRITON), as PyPI's torch would"; $(PY) -m pip install -q "$(TRITON)"; fi
 	@touch $@
 
 $(VENV)/.stamp-%: pyproject.toml | $(VENV)/bin/python

@@ -8,7 +8,14 @@ Two front doors::
 Importing mjmaze picks no GL backend: see :mod:`mjmaze.render` (``MUJOCO_GL``).
 """
 
-import warnings
+from mjmaze import llvm_clash as _llvm_clash
+
+# First, before anything of mjmaze imports mujoco or renders: with triton
+# installed (PyPI's torch), Mesa's LLVM loaded first would make `import triton`
+# crash the process (see mjmaze.llvm_clash).
+_llvm_clash.load_triton_first()
+
+import warnings  # noqa: E402
 
 with warnings.catch_warnings():
     # dm_control tries GLFW when it is imported; without a display that only

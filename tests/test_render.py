@@ -80,3 +80,51 @@ def test_the_backend_this_machine_has_renders(tmp_path):
     expected = "egl" if render._egl_device_available() else "osmesa"
     backend, frames = _render_with(expected, tmp_path)
     assert backend == expected and all(frame.std() > 5 for frame in frames)
+
+
+# PyPI's torch brings triton; torch imports it when it first builds an optimizer.
+# With Mesa's LLVM loaded first, that import used to kill the process (SIGSEGV):
+# see mjmaze.llvm_clash. Each order a user's script can take, in a fresh process.
+_RENDER_THEN_TRAIN = """
+{first}
+env = mjmaze.load("labyrinth", task_kwargs={{"size": 5, "random": 0}})
+env.reset(); env.step(2)
+import triton
+import torch
+torch.optim.RMSprop(torch.nn.Linear(4, 2).parameters()).step()
+print("trained after rendering")
+"""
+_FIRST_IMPORTS = {
+    "mjmaze first": "import mjmaze",
+    "mujoco first": "import mujoco\nimport mjmaze",  # under MUJOCO_GL=osmesa this loads Mesa's LLVM
+    "frame before mjmaze": (  # a plain MuJoCo frame, rendered before mjmaze is imported
+        "import mujoco\nfrom mujoco.{backend} import GLContext\n"
+        "context = GLContext(64, 64); context.make_current()\n"
+        "mujoco.MjrContext(mujoco.MjModel.from_xml_string('<mujoco/>'), 50)\nimport mjmaze"
+    ),
+}
+
+
+def _backends_here():
+    return [name for name, works in (("egl", render._egl_device_available()), ("osmesa", render._osmesa_available()))
+            if works]
+
+
+@pytest.mark.parametrize("order", sorted(_FIRST_IMPORTS))
+@pytest.mark.parametrize("backend", ["egl", "osmesa"])
+def test_importing_triton_after_rendering_does_not_crash(backend, order):
+    from mjmaze import llvm_clash
+
+    if llvm_clash.triton_library() is None:
+        # `make test` installs triton (what PyPI's torch brings), so CI must not skip this.
+        if os.environ.get("CI"):
+            pytest.fail("triton is not installed: `make test` installs the version PyPI's torch pins")
+        pytest.skip("triton is not installed (`make test` installs it)")
+    if backend not in _backends_here():
+        pytest.skip(f"{backend} cannot be opened on this machine")
+    env = {**os.environ, "MUJOCO_GL": backend}
+    env.pop("PYOPENGL_PLATFORM", None)
+    script = _RENDER_THEN_TRAIN.format(first=_FIRST_IMPORTS[order].format(backend=backend))
+    out = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, f"exit {out.returncode} ({order}, {backend}): {out.stderr[-2000:]}"
+    assert "trained after rendering" in out.stdout
