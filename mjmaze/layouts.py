@@ -137,7 +137,12 @@ def from_paper_json(path: str | os.PathLike, scenario: str, index: int = 0, spli
 def load_folder(folder: str | os.PathLike, scenario: str) -> list[configs.MazeConfig]:
     """Every ``*.json`` in ``folder`` (sorted by name) as configurations."""
     folder = pathlib.Path(folder)
+    hint = "layouts= takes a folder of the released mazes' *.json files, e.g. .../labyrinth/9/test"
+    if not folder.exists():
+        raise LayoutError(f"{folder}: no such folder; {hint}")
+    if not folder.is_dir():
+        raise LayoutError(f"{folder}: a file, not a folder; {hint} (here: layouts={str(folder.parent)!r})")
     files = sorted(folder.glob("*.json"))
     if not files:
-        raise LayoutError(f"{folder}: no *.json layout files found")
+        raise LayoutError(f"{folder}: no *.json files in this folder; {hint}")
     return [from_paper_json(file, scenario, index=i, split=folder.name) for i, file in enumerate(files)]

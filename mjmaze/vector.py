@@ -387,6 +387,7 @@ class MazeVectorEnv(gym.vector.VectorEnv):
         self._shm = shared_memory.SharedMemory(
             name=SHARED_MEMORY_PREFIX + secrets.token_hex(8), create=True, size=_layout_size(layout)
         )
+        self._segment_unlinked = False
         self._arrays = _views(layout, self._shm.buf)
         self._scalars = self._arrays["scalars"]
 
@@ -418,6 +419,10 @@ class MazeVectorEnv(gym.vector.VectorEnv):
                 local = shares[-1]
                 self._local = _EnvGroup(self._arrays, local, [offsets[i] for i in local], scenario, task_kwargs, same_step)
             self._collect()  # every worker has built its envs
+            # Every process has mapped the segment now: its name can go. The
+            # memory lives until the last mapping does, so nothing is left in
+            # /dev/shm even when the whole process group is killed (-9, OOM).
+            self._unlink_segment()
         except WorkerError as error:
             raise WorkerError(
                 f"{error}\nWorkers are started with {context!r}: a script that makes a vector env must do so "
@@ -622,4 +627,9 @@ class MazeVectorEnv(gym.vector.VectorEnv):
             self._shm.close()
         except BufferError:  # the caller still holds an uncopied observation; the name goes anyway
             pass
-        self._shm.unlink()
+        self._unlink_segment()
+
+    def _unlink_segment(self) -> None:
+        if not self._segment_unlinked:
+            self._segment_unlinked = True
+            self._shm.unlink()

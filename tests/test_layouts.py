@@ -1,6 +1,7 @@
 """Import of the paper's per-configuration JSON layouts."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -127,5 +128,16 @@ def test_a_folder_of_the_wrong_size_is_refused(tmp_path):
     write(tmp_path / "a.json", to_paper_json(config, "labyrinth"))
     with pytest.raises(ValueError, match="7x7"):
         mjmaze.load("labyrinth", task_kwargs={"size": 9, "layouts": tmp_path})
-    with pytest.raises(layouts.LayoutError, match="no \\*.json"):
-        mjmaze.load("labyrinth", task_kwargs={"size": 9, "layouts": tmp_path / "empty"})
+
+
+def test_layouts_that_are_not_a_folder_of_mazes_say_what_to_pass(tmp_path):
+    config = mjmaze.load("labyrinth", task_kwargs={"size": 5}).task.configs[0]
+    single = write(tmp_path / "custom_scenario000.json", to_paper_json(config, "labyrinth"))
+    (tmp_path / "empty").mkdir()
+    for where, problem in ((tmp_path / "missing", "no such folder"), (single, "a file, not a folder"),
+                           (tmp_path / "empty", "no \\*.json files")):
+        with pytest.raises(layouts.LayoutError, match=problem) as error:
+            mjmaze.load("labyrinth", task_kwargs={"size": 5, "layouts": where})
+        assert "layouts= takes a folder" in str(error.value)
+    with pytest.raises(layouts.LayoutError, match=re.escape(repr(str(tmp_path)))):  # the file's folder is named
+        mjmaze.load("labyrinth", task_kwargs={"size": 5, "layouts": single})

@@ -4,12 +4,14 @@ import csv
 import json
 import os
 import pathlib
+import re
 import signal
 import subprocess
 import sys
 import time
 
 import pytest
+import torch
 
 import mjmaze
 
@@ -98,6 +100,19 @@ def test_a_tiny_grid_survives_a_kill_resumes_without_redoing_and_reports(tmp_pat
     text = (tmp_path / "tiny" / "report.md").read_text()
     assert "| 1 | 2 | " in text and "1941 ± 4" in text
     assert (tmp_path / "tiny" / "curves_two_colour.png").stat().st_size > 1000
+
+
+@pytest.mark.parametrize("flags, message", [
+    (["--eval-configs", "4"], "got 16 envs: use one of [1, 2, 4]"),  # the default --eval-envs 16
+    (["--num-steps", "0"], "--num-steps must be at least 1, got 0"),
+    (["--cpus-per-run", "0"], "--cpus-per-run must be at least 1"),
+    (["--device", "cuda:7"] if torch.cuda.is_available() else ["--device", "cuda"], "--device cuda"),
+])
+def test_flags_that_would_fail_after_training_fail_before_it(tmp_path, monkeypatch, flags, message):
+    monkeypatch.setattr(sweep, "launch", lambda *a, **k: pytest.fail("launched"))
+    with pytest.raises(SystemExit, match=re.escape(message)):
+        sweep.main(["--grid", "small", "--sweeps-dir", str(tmp_path), *flags])
+    assert not any(tmp_path.iterdir())  # nothing written: not even sweep.json
 
 
 def test_a_run_asking_for_a_gpu_ray_lacks_is_one_clear_error(tmp_path):

@@ -2,6 +2,7 @@
 
 import json
 import math
+import re
 
 import pytest
 import torch
@@ -165,6 +166,39 @@ def test_a_run_from_before_head_bob_and_flashes_resumes_and_plays_only_without_t
         checkpoint.load(latest, {**state["config"], "head_bob": False, "flashes": True})
     args, _, _ = policy.load_run(run)  # evaluation and analysis play it as it was trained
     assert (args.head_bob, args.flashes) == (False, False)
+
+
+@pytest.mark.parametrize("flags, message", [
+    (["--num-steps", "0"], "--num-steps must be at least 1, got 0"),
+    (["--num-envs", "0"], "--num-envs must be at least 1, got 0"),
+    (["--total-steps", "-5"], "--total-steps must be at least 1"),
+    (["--lr", "0"], "--lr must be positive"),
+    (["--backend", "tpu"], "--backend must be cpu or warp"),
+    (["--device", "gpu0"], "--device 'gpu0' is not a device: use auto, cpu or cuda"),
+    (["--size", "6"], "size must be one of"),
+])
+def test_flags_that_cannot_train_are_one_line_before_anything_starts(tmp_path, flags, message):
+    with pytest.raises(SystemExit, match=re.escape(message)) as error:
+        a2c.main(["--runs-dir", str(tmp_path), "--run-name", "bad", "--no-progress", *flags])
+    assert str(error.value).startswith("error: ") and "\n" not in str(error.value)
+    assert not (tmp_path / "bad").exists()  # nothing was written
+
+
+@pytest.mark.skipif(torch.cuda.is_available(), reason="this machine has CUDA")
+@pytest.mark.parametrize("backend", ["cpu", "warp"])
+def test_cuda_without_cuda_is_one_line_that_says_what_to_pass(tmp_path, backend):
+    with pytest.raises(SystemExit, match="--device cuda: .*use --device cpu") as error:
+        a2c.main(["--runs-dir", str(tmp_path), "--backend", backend, "--device", "cuda", "--no-progress"])
+    assert "\n" not in str(error.value)
+    with pytest.raises(SystemExit, match="--device cuda: .*use --device cpu"):
+        evaluate.main([str(tmp_path / "a_run"), "--device", "cuda"])
+
+
+def test_evaluation_sizes_that_cannot_play_every_configuration_twice_name_what_works():
+    with pytest.raises(SystemExit, match=re.escape("got 5 envs: use one of [1, 2, 4, 8, 16, 32, 64]")):
+        evaluate.main(["random", "--num-envs", "5"])
+    with pytest.raises(ValueError, match="at least 1 env"):
+        evaluate.check_sizes(0)
 
 
 def test_flags_for_another_scenario_are_refused():

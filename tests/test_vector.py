@@ -2,6 +2,7 @@
 
 import os
 import signal
+import time
 
 import gymnasium
 import numpy as np
@@ -159,6 +160,33 @@ def test_close_ends_the_workers_and_frees_shared_memory():
     envs.close()  # twice is fine
     with pytest.raises(WorkerError, match="closed"):
         envs.step(np.zeros(2, dtype=int))
+
+
+_HOLD_A_VECTOR_ENV = """
+import time
+from mjmaze.vector import MazeVectorEnv
+envs = MazeVectorEnv(2, "labyrinth", size=5, num_workers=2)
+envs.reset(seed=0)
+print("ready", flush=True)
+time.sleep(300)
+"""
+
+
+def test_kill_9_of_everything_leaves_no_shared_memory():
+    import subprocess
+    import sys
+
+    before = our_segments()
+    # Its own process group, so that the kill takes the workers and Python's resource tracker too.
+    process = subprocess.Popen([sys.executable, "-c", _HOLD_A_VECTOR_ENV], stdout=subprocess.PIPE, text=True,
+                               start_new_session=True)
+    try:
+        assert process.stdout.readline().strip() == "ready"
+    finally:
+        os.killpg(process.pid, signal.SIGKILL)
+        process.wait(timeout=30)
+    time.sleep(0.5)
+    assert our_segments() == before, "a killed run left its segment in /dev/shm"
 
 
 def test_bad_arguments_fail_in_the_calling_process():

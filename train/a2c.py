@@ -42,7 +42,6 @@ from .model import Agent
 from .settings import Args, pick_device
 
 
-
 def n_step_returns(rewards: torch.Tensor, dones: torch.Tensor, last_value: torch.Tensor, gamma: float) -> torch.Tensor:
     """Bootstrapped n-step returns: ``R_t = r_t + gamma * (1 - done_t) * R_{t+1}``, ``R_T = V(s_T)``.
 
@@ -80,6 +79,7 @@ class _Stop(Exception):
 
 def train(args: Args) -> pathlib.Path:
     """Trains, checkpointing as it goes; returns the run's folder."""
+    args.validate()
     task_kwargs = args.task_kwargs()
     run_dir = pathlib.Path(args.runs_dir) / args.name()
     checkpoint_dir = run_dir / "checkpoints"
@@ -103,10 +103,8 @@ def train(args: Args) -> pathlib.Path:
     if args.backend == "warp":
         # The envs live on the network's device: observations never leave it.
         options = dict(device=str(device), keep_final_obs=False)
-    elif args.backend == "cpu":
-        options = dict(num_workers=args.num_workers, copy=False)
     else:
-        raise ValueError(f"--backend must be cpu or warp, got {args.backend!r}")
+        options = dict(num_workers=args.num_workers, copy=False)
     make_envs = functools.partial(
         make_vector_env, args.num_envs, args.scenario, backend=args.backend, autoreset_mode="same_step",
         split="train", **options, **task_kwargs,

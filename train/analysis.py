@@ -40,6 +40,7 @@ import mjmaze
 from mjmaze import files, registry, suite
 
 from . import checkpoint, policy
+from .settings import using_torch_threads
 
 TSNE_STATES = 2000
 TSNE_LINES = 20
@@ -51,7 +52,8 @@ def record_states(source_args: argparse.Namespace, episodes: int, max_steps: int
     scenario, task_kwargs, agent_policy, description = policy.policy_from_arguments(source_args)
     env = mjmaze.load(scenario, task_kwargs={**task_kwargs, "split": source_args.split, "random": source_args.seed})
     try:
-        played = policy.play_episodes(env, agent_policy, episodes, max_steps=max_steps)
+        with using_torch_threads(policy.threads_of(source_args)):
+            played = policy.play_episodes(env, agent_policy, episodes, max_steps=max_steps, progress=True)
     finally:
         env.task.close()
     return scenario, task_kwargs, description, played

@@ -23,6 +23,7 @@ import pathlib
 
 import numpy as np
 from matplotlib.figure import Figure
+from tqdm import tqdm
 
 from mjmaze import files, registry
 
@@ -59,14 +60,18 @@ def read_run(run_dir: pathlib.Path) -> dict:
     return {"dir": str(run_dir), "config": config, "steps": np.array(steps), "values": np.array(values), "evals": evals}
 
 
-def evaluate_checkpoints(run_dir: pathlib.Path, num_envs: int = 16) -> None:
+def evaluate_checkpoints(run_dir: pathlib.Path, num_envs: int = 16,
+                         torch_threads: int | None = evaluate.INFERENCE_THREADS) -> None:
     """Greedy evaluation of each kept checkpoint not evaluated yet (cached in ``evals/``)."""
-    for path in checkpoint.checkpoints(run_dir / "checkpoints"):
+    evaluate.check_sizes(num_envs)
+    todo = [path for path in checkpoint.checkpoints(run_dir / "checkpoints")
+            if not (run_dir / "evals" / path.with_suffix(".json").name).exists()]
+    bar = tqdm(todo, desc=f"{run_dir.name} checkpoints", unit="ckpt", disable=None, dynamic_ncols=True)
+    for path in bar:
         out = run_dir / "evals" / path.with_suffix(".json").name
-        if not out.exists():
-            result = evaluate.evaluate(run_dir, path, num_envs=num_envs, out=out)
-            print(f"  {run_dir.name} step {result['step']:>11,}: train {result['train']['value']:6.1f}  "
-                  f"test {result['test']['value']:6.1f}  ({result['units']})", flush=True)
+        result = evaluate.evaluate(run_dir, path, num_envs=num_envs, out=out, torch_threads=torch_threads)
+        bar.write(f"  {run_dir.name} step {result['step']:>11,}: train {result['train']['value']:6.1f}  "
+                  f"test {result['test']['value']:6.1f}  ({result['units']})")
 
 
 def group_key(config: dict) -> tuple:
@@ -208,6 +213,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("runs/curves.png"))
     parser.add_argument("--evaluate", action="store_true", help="evaluate kept checkpoints not evaluated yet")
     parser.add_argument("--num-envs", type=int, default=16, help="parallel envs for --evaluate (must divide 64)")
+    parser.add_argument("--torch-threads", type=int, default=evaluate.INFERENCE_THREADS,
+                        help="PyTorch CPU threads for --evaluate (default 1: one small batch per step)")
     parser.add_argument("--bins", type=int, default=BINS)
     parser.add_argument("--each-run", action="store_true",
                         help="a curve per run, named by its folder (to compare variants, not seeds)")
@@ -215,7 +222,7 @@ def main(argv: list[str] | None = None) -> None:
     try:
         if args.evaluate:
             for run_dir in args.runs:
-                evaluate_checkpoints(run_dir, args.num_envs)
+                evaluate_checkpoints(run_dir, args.num_envs, args.torch_threads)
         groups = curves(args.runs, args.bins, each_run=args.each_run)
     except (checkpoint.CheckpointError, FileNotFoundError, ValueError) as error:
         raise SystemExit(f"error: {error}") from None

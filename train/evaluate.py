@@ -18,28 +18,40 @@ import pathlib
 
 import numpy as np
 import torch
+from tqdm import tqdm
 
 from mjmaze import files, registry, suite
 from mjmaze.vector import MazeVectorEnv
 
 from . import checkpoint, policy
-from .settings import Args, pick_device
 from .model import Agent
+from .settings import INFERENCE_THREADS, Args, pick_device, using_torch_threads
 
 EVAL_CONFIGS = 64
 PLAYS_PER_CONFIG = 2
 
 
+def check_sizes(num_envs: int, num_configs: int | None = None) -> int:
+    """The number of configurations per split (default ``EVAL_CONFIGS``); ValueError if ``num_envs`` cannot play them."""
+    num_configs = EVAL_CONFIGS if num_configs is None else num_configs
+    if num_configs < 1 or num_envs < 1:
+        raise ValueError(f"evaluation needs at least 1 env and 1 configuration, got {num_envs} envs, {num_configs} "
+                         "configurations")
+    if num_configs % num_envs:
+        divisors = [n for n in range(1, num_configs + 1) if num_configs % n == 0]
+        raise ValueError(f"the number of evaluation envs must divide the {num_configs} configurations per split, "
+                         f"got {num_envs} envs: use one of {divisors}")
+    return num_configs
+
+
 def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, device: torch.device, seed: int = 0,
-               num_configs: int | None = None) -> dict:
+               num_configs: int | None = None, progress: bool = True) -> dict:
     """Plays each of the first ``num_configs`` (default ``EVAL_CONFIGS``) configurations of ``split`` twice.
 
     Actions are the argmax of ``agent``'s policy, or uniformly random ones
     (seeded with ``seed``) for ``agent=None``.
     """
-    num_configs = num_configs or EVAL_CONFIGS
-    if num_configs % num_envs:
-        raise ValueError(f"num_envs must divide {num_configs}, got {num_envs}")
+    num_configs = check_sizes(num_envs, num_configs)
     # Env i starts at configuration i * 64 / num_envs and cycles, so its first
     # 2 * 64 / num_envs episodes cover its block and the next: every
     # configuration exactly twice.
@@ -53,6 +65,8 @@ def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, devic
     declared = registry.get(args.scenario)
     random_actions = np.random.default_rng(seed)
     episodes: list[list[dict]] = [[] for _ in range(num_envs)]
+    bar = tqdm(total=num_envs * per_env, desc=f"{split} episodes", unit="ep", leave=False,
+               disable=None if progress else True, dynamic_ncols=True)
     try:
         obs, _ = envs.reset(seed=seed)
         hidden = agent.initial_state(num_envs, device) if agent is not None else None
@@ -71,7 +85,9 @@ def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, devic
             for i in np.flatnonzero(ended):
                 if len(episodes[i]) < per_env:
                     episodes[i].append({k: v[i].item() for k, v in infos["final_info"].items() if not k.startswith("_")})
+                    bar.update()
     finally:
+        bar.close()
         envs.close()
     played = [e for env_episodes in episodes for e in env_episodes]
     values = np.array([e[metric] for e in played], dtype=float) * scale
@@ -88,27 +104,37 @@ def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, devic
 
 
 def evaluate_random(args: Args, num_envs: int = 16, out: str | pathlib.Path | None = None,
-                    num_configs: int | None = None, seed: int = 0) -> dict:
+                    num_configs: int | None = None, seed: int = 0, progress: bool = True) -> dict:
     """A uniformly random policy, evaluated as :func:`evaluate` evaluates a run; written to ``out`` if given."""
+    check_sizes(num_envs, num_configs)
     result = {
         "run": "random", "checkpoint": None, "step": 0, "scenario": args.scenario,
         "task_kwargs": args.task_kwargs(), "units": suite.paper_metric(args.scenario)[2],
     }
     for split in ("train", "test"):
-        result[split] = play_split(None, args, split, num_envs, torch.device("cpu"), seed=seed, num_configs=num_configs)
+        result[split] = play_split(None, args, split, num_envs, torch.device("cpu"), seed=seed, num_configs=num_configs,
+                                   progress=progress)
     if out:
         files.atomic_write_json(pathlib.Path(out), result)
     return result
 
 
 def evaluate(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | None = None, num_envs: int = 16,
-             device: str = "auto", out: str | pathlib.Path | None = None, num_configs: int | None = None) -> dict:
+             device: str = "auto", out: str | pathlib.Path | None = None, num_configs: int | None = None,
+             torch_threads: int | None = INFERENCE_THREADS, progress: bool = True) -> dict:
     """Evaluates a run's checkpoint (default: its latest) on train and test.
 
     ``num_configs`` configurations per split (default ``EVAL_CONFIGS`` = 64),
     each played twice. Writes the result to ``out`` (default: the run's ``eval.json``).
+    ``torch_threads``: PyTorch's CPU threads meanwhile (None: as they are).
     """
+    check_sizes(num_envs, num_configs)
     torch_device = pick_device(device)
+    with using_torch_threads(torch_threads):
+        return _evaluate(run_dir, checkpoint_path, num_envs, torch_device, out, num_configs, progress)
+
+
+def _evaluate(run_dir, checkpoint_path, num_envs, torch_device, out, num_configs, progress) -> dict:
     args, agent, state = policy.load_run(run_dir, checkpoint_path, torch_device)
     result = {
         "run": str(run_dir),
@@ -119,7 +145,8 @@ def evaluate(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | 
         "units": suite.paper_metric(args.scenario)[2],
     }
     for split in ("train", "test"):
-        result[split] = play_split(agent, args, split, num_envs, torch_device, num_configs=num_configs)
+        result[split] = play_split(agent, args, split, num_envs, torch_device, num_configs=num_configs,
+                                   progress=progress)
     files.atomic_write_json(pathlib.Path(out) if out else pathlib.Path(run_dir) / "eval.json", result)
     return result
 
@@ -143,6 +170,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--checkpoint", type=pathlib.Path, default=None, help="default: the run's latest")
     parser.add_argument("--num-envs", type=int, default=16, help="parallel envs (must divide 64)")
     parser.add_argument("--device", default="auto")
+    parser.add_argument("--torch-threads", type=int, default=INFERENCE_THREADS,
+                        help="PyTorch CPU threads (default 1: the network reads one small batch per step)")
     parser.add_argument("--out", type=pathlib.Path, default=None,
                         help="where to write the result (default: the run's eval.json; for random, nowhere)")
     suite.difficulty_arguments(parser)  # for random: the scenario and its difficulty
@@ -152,7 +181,8 @@ def main(argv: list[str] | None = None) -> None:
             settings = Args(scenario=args.scenario or suite.DEFAULT_SCENARIO, **suite.difficulty_kwargs(args))
             result = evaluate_random(settings, args.num_envs, args.out)
         else:
-            result = evaluate(args.run_dir, args.checkpoint, args.num_envs, args.device, out=args.out)
+            result = evaluate(args.run_dir, args.checkpoint, args.num_envs, args.device, out=args.out,
+                              torch_threads=args.torch_threads)
     except (checkpoint.CheckpointError, FileNotFoundError, ValueError) as error:
         raise SystemExit(f"error: {error}") from None
     print(format_table(result))

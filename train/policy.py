@@ -17,11 +17,12 @@ from collections.abc import Callable
 
 import numpy as np
 import torch
+from tqdm import tqdm
 
 from mjmaze import suite, viz
 
 from . import checkpoint
-from .settings import Args
+from .settings import INFERENCE_THREADS, Args
 from .model import Agent
 
 RANDOM = "random"
@@ -118,14 +119,16 @@ class Episode:
 
 def play_episodes(env, policy: Policy, episodes: int, keep_frames: bool = False,
                   top_down: viz.TopDown | None = None, max_steps: int | None = None,
-                  on_episode: Callable[[Episode], None] | None = None) -> list[Episode]:
+                  on_episode: Callable[[Episode], None] | None = None, progress: bool = False) -> list[Episode]:
     """Plays ``episodes`` episodes of ``env`` (from :func:`mjmaze.load`) with ``policy``.
 
     ``top_down``: also keep the map of every frame. ``max_steps``: cut episodes
-    short (for quick looks); the time limit still applies.
+    short (for quick looks); the time limit still applies. ``progress``: a
+    progress bar on a terminal.
     """
     played = []
-    for _ in range(episodes):
+    for _ in tqdm(range(episodes), desc="episodes", unit="ep", leave=False, disable=None if progress else True,
+                  dynamic_ncols=True):
         played.append(_play_episode(env, policy, keep_frames, top_down, max_steps))
         if on_episode is not None:
             on_episode(played[-1])
@@ -172,6 +175,8 @@ def policy_arguments(parser: argparse.ArgumentParser) -> None:
     suite.difficulty_arguments(parser)
     parser.add_argument("--split", default="test", choices=("train", "test"))
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--torch-threads", type=int, default=INFERENCE_THREADS,
+                        help="PyTorch CPU threads (default 1: the network reads one frame per step)")
 
 
 def policy_from_arguments(args: argparse.Namespace) -> tuple[str, dict, Policy, str]:
@@ -194,6 +199,11 @@ def policy_from_arguments(args: argparse.Namespace) -> tuple[str, dict, Policy, 
     mode = "sample" if args.sample else "greedy"
     policy = Policy(agent, mode, args.seed)
     return run_args.scenario, task_kwargs, policy, f"{pathlib.Path(args.source).name} @ {state['step']:,} steps ({mode})"
+
+
+def threads_of(args: argparse.Namespace) -> int:
+    """The ``--torch-threads`` of :func:`policy_arguments` flags (1 where a caller built them without it)."""
+    return getattr(args, "torch_threads", INFERENCE_THREADS)
 
 
 def metric_of(scenario: str, info: dict) -> str:

@@ -19,11 +19,13 @@ import pathlib
 
 import imageio.v2 as imageio
 import numpy as np
+from tqdm import tqdm
 
 import mjmaze
 from mjmaze import files, suite, viz
 
 from . import checkpoint, policy
+from .settings import using_torch_threads
 
 FPS = 35 / 4  # real time: one frame per agent step (4 tics at 35 Hz)
 MAP_SIZE = 256
@@ -83,10 +85,11 @@ def record(source_args: argparse.Namespace, episodes: int, out: pathlib.Path, fp
     try:
         writer = _writer(tmp, fps)
         try:
-            for k in range(episodes):
+            for k in tqdm(range(episodes), desc="episodes", unit="ep", leave=False, disable=None, dynamic_ncols=True):
                 # One episode at a time: its maps are the memory-hungry part.
-                (episode,) = policy.play_episodes(env, agent_policy, 1, keep_frames=True, top_down=top_down,
-                                                  max_steps=max_steps)
+                with using_torch_threads(policy.threads_of(source_args)):
+                    (episode,) = policy.play_episodes(env, agent_policy, 1, keep_frames=True, top_down=top_down,
+                                                      max_steps=max_steps)
                 title = f"episode {k + 1}/{episodes}  config {episode.config_index}"
                 for frame in episode_frames(episode, top_down, scenario, header, title):
                     writer.append_data(frame)

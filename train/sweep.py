@@ -31,6 +31,8 @@ import pathlib
 import sys
 import time
 
+from tqdm import tqdm
+
 from mjmaze import files, registry, suite
 
 from . import a2c, checkpoint, evaluate
@@ -147,9 +149,11 @@ def run_one(spec: RunSpec, settings: dict, sweep_dir: str, eval_envs: int, eval_
 
 def launch(specs: list[RunSpec], sweep_dir: pathlib.Path, settings: dict, *, address: str | None = None,
            num_cpus: int | None = None, cpus_per_run: int = 2, gpus_per_run: float = 0.0, retries: int = 1,
-           eval_envs: int = 16, eval_configs: int = evaluate.EVAL_CONFIGS, log=print) -> list[dict]:
+           eval_envs: int = 16, eval_configs: int = evaluate.EVAL_CONFIGS, log=tqdm.write) -> list[dict]:
     """Runs ``specs`` on Ray (skipping finished runs); returns one result per run, finished ones included."""
     import ray
+
+    evaluate.check_sizes(eval_envs, eval_configs)  # a run's evaluation comes only after its training
 
     sweep_dir = pathlib.Path(sweep_dir).resolve()  # Ray workers do not share the driver's working directory
     results, todo = [], []
@@ -177,6 +181,7 @@ def launch(specs: list[RunSpec], sweep_dir: pathlib.Path, settings: dict, *, add
         pending = {remote.remote(spec, settings, str(sweep_dir), eval_envs, eval_configs): spec for spec in todo}
         log(f"[sweep] {len(todo)} run(s) submitted, {len(results)} already finished; {sweep_dir}")
         start = time.monotonic()
+        bar = tqdm(total=len(todo), desc="runs", unit="run", disable=None, dynamic_ncols=True)
         while pending:
             (ready,), _ = ray.wait(list(pending), num_returns=1)
             spec = pending.pop(ready)
@@ -191,6 +196,8 @@ def launch(specs: list[RunSpec], sweep_dir: pathlib.Path, settings: dict, *, add
                 log(f"[sweep] {spec.name}: {result['status']}; {e['units']} train {e['train']['value']:.3g} "
                     f"test {e['test']['value']:.3g} ({time.monotonic() - start:.0f} s, {len(pending)} left)")
             results.append(result)
+            bar.update()
+        bar.close()
     finally:
         ray.shutdown()
     return results
@@ -249,10 +256,14 @@ def main(argv: list[str] | None = None) -> None:
     }
     sweep_dir = args.sweeps_dir / (args.name or args.grid)
     try:
+        # Every flag and every run's settings are valid before anything starts:
+        # a bad one would otherwise fail only after hours of training.
+        if args.cpus_per_run < 1 or args.gpus_per_run < 0 or args.retries < 0:
+            raise ValueError("--cpus-per-run must be at least 1, --gpus-per-run and --retries at least 0")
+        evaluate.check_sizes(args.eval_envs, args.eval_configs)
         for spec in specs:
-            # Every run's task is valid before anything starts.
             run_args = spec.args(settings, args.sweeps_dir)
-            suite.make_task(spec.scenario, run_args.task_kwargs())
+            run_args.validate()
             check_same_run(sweep_dir / spec.name, dataclasses.asdict(run_args))
     except ValueError as error:
         raise SystemExit(f"error: {error}") from None
