@@ -151,12 +151,12 @@ def analyse(source_args: argparse.Namespace, episodes: int, out: pathlib.Path | 
     """Records states, writes the files listed in the module docstring; returns the summary."""
     scenario, task_kwargs, description, played = record_states(source_args, episodes, max_steps)
     if out is None:
-        out = pathlib.Path(source_args.source) / "analysis" if source_args.source != policy.RANDOM \
+        out = policy.output_folder(source_args.source) / "analysis" if source_args.source != policy.RANDOM \
             else pathlib.Path("runs") / f"analysis_random_{scenario}"
     played = [e for e in played if e.length > 0]
     if not played:
         raise ValueError("no episode lasted a step: nothing to analyse")
-    title = f"{description} | {scenario} {task_kwargs} | {source_args.split}"
+    title = f"{description} | {scenario} {policy.describe(task_kwargs)} | {source_args.split}"
     hidden = np.concatenate([e.hidden for e in played])
     episode_of = np.concatenate([np.full(e.length, k) for k, e in enumerate(played)])
     steps = np.concatenate([np.arange(e.length) for e in played])

@@ -45,11 +45,12 @@ def check_sizes(num_envs: int, num_configs: int | None = None) -> int:
 
 
 def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, device: torch.device, seed: int = 0,
-               num_configs: int | None = None, progress: bool = True) -> dict:
+               num_configs: int | None = None, progress: bool = True, layouts: str | None = None) -> dict:
     """Plays each of the first ``num_configs`` (default ``EVAL_CONFIGS``) configurations of ``split`` twice.
 
     Actions are the argmax of ``agent``'s policy, or uniformly random ones
-    (seeded with ``seed``) for ``agent=None``.
+    (seeded with ``seed``) for ``agent=None``. ``layouts``: a folder of
+    released mazes to play instead of the split's generated ones.
     """
     num_configs = check_sizes(num_envs, num_configs)
     # Env i starts at configuration i * 64 / num_envs and cycles, so its first
@@ -57,6 +58,8 @@ def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, devic
     # configuration exactly twice.
     per_env = PLAYS_PER_CONFIG * num_configs // num_envs
     task_kwargs = {k: v for k, v in args.task_kwargs().items() if k != "num_configs"}
+    if layouts is not None:
+        task_kwargs["layouts"] = layouts
     envs = MazeVectorEnv(
         num_envs, args.scenario, autoreset_mode="same_step", copy=False, split=split,
         num_configs=num_configs, config_sampling="cycle", **task_kwargs,
@@ -65,6 +68,7 @@ def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, devic
     declared = registry.get(args.scenario)
     random_actions = np.random.default_rng(seed)
     episodes: list[list[dict]] = [[] for _ in range(num_envs)]
+    steps = np.zeros(num_envs, dtype=np.int64)  # of each env's current episode
     bar = tqdm(total=num_envs * per_env, desc=f"{split} episodes", unit="ep", leave=False,
                disable=None if progress else True, dynamic_ncols=True)
     try:
@@ -82,10 +86,13 @@ def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, devic
             obs, _, terminated, truncated, infos = envs.step(actions)
             ended = terminated | truncated
             starts = torch.from_numpy(ended)
+            steps += 1
             for i in np.flatnonzero(ended):
                 if len(episodes[i]) < per_env:
-                    episodes[i].append({k: v[i].item() for k, v in infos["final_info"].items() if not k.startswith("_")})
+                    episode = {k: v[i].item() for k, v in infos["final_info"].items() if not k.startswith("_")}
+                    episodes[i].append({**episode, "length": int(steps[i])})
                     bar.update()
+            steps[ended] = 0
     finally:
         bar.close()
         envs.close()
@@ -97,6 +104,7 @@ def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, devic
         "std": float(values.std()),
         "episodes": len(played),
         "mean_return": float(np.mean([e["episode_return"] for e in played])),
+        "mean_length": float(np.mean([e["length"] for e in played])),  # agent steps
         # In the units of the paper's training curves (the metric but for K-item's normalised return).
         "curve_value": float(np.mean([e[declared.curve_field] for e in played])) * declared.curve_scale,
         "configs": sorted(e["config_index"] for e in played),
@@ -144,11 +152,19 @@ def _evaluate(run_dir, checkpoint_path, num_envs, torch_device, out, num_configs
         "task_kwargs": args.task_kwargs(),
         "units": suite.paper_metric(args.scenario)[2],
     }
+    layouts = state.get("layouts", {})  # a paper agent's released mazes
+    if layouts:
+        result["released_mazes"] = layouts
     for split in ("train", "test"):
         result[split] = play_split(agent, args, split, num_envs, torch_device, num_configs=num_configs,
-                                   progress=progress)
-    files.atomic_write_json(pathlib.Path(out) if out else pathlib.Path(run_dir) / "eval.json", result)
+                                   progress=progress, layouts=layouts.get(split))
+    files.atomic_write_json(pathlib.Path(out) if out else default_output(run_dir), result)
     return result
+
+
+def default_output(source: str | pathlib.Path) -> pathlib.Path:
+    """Where :func:`evaluate` writes by default: the run's ``eval.json`` (``runs/paper/<setting>/eval.json`` for a paper agent)."""
+    return policy.output_folder(str(source)) / "eval.json"
 
 
 def format_table(result: dict) -> str:
@@ -166,7 +182,8 @@ def format_table(result: dict) -> str:
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("run_dir", type=pathlib.Path, help="a run folder, or 'random' for a uniformly random policy")
+    parser.add_argument("run_dir", help="a run folder, 'random' for a uniformly random policy, or paper:<setting> "
+                        "for one of the paper's agents on the released mazes (e.g. paper:labyrinth_9)")
     parser.add_argument("--checkpoint", type=pathlib.Path, default=None, help="default: the run's latest")
     parser.add_argument("--num-envs", type=int, default=16, help="parallel envs (must divide 64)")
     parser.add_argument("--device", default="auto")
@@ -187,7 +204,7 @@ def main(argv: list[str] | None = None) -> None:
         raise SystemExit(f"error: {error}") from None
     print(format_table(result))
     if result["run"] != "random" or args.out:
-        print(f"written: {args.out or args.run_dir / 'eval.json'}")
+        print(f"written: {args.out or default_output(args.run_dir)}")
 
 
 if __name__ == "__main__":

@@ -21,7 +21,7 @@ from tqdm import tqdm
 
 from mjmaze import suite, viz
 
-from . import checkpoint
+from . import checkpoint, paper_agents
 from .settings import INFERENCE_THREADS, Args
 from .model import Agent
 
@@ -30,7 +30,16 @@ RANDOM = "random"
 
 def load_run(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | None = None,
              device: torch.device | str = "cpu") -> tuple[Args, Agent, dict]:
-    """``(args, agent in eval mode, checkpoint state)`` of a run; default: its latest checkpoint."""
+    """``(args, agent in eval mode, checkpoint state)`` of a run; default: its latest checkpoint.
+
+    ``run_dir`` may name one of the paper's agents, ``paper:<setting>``
+    (:mod:`mjmaze.train.paper_agents`); its state then holds ``layouts``, the
+    released mazes of each split.
+    """
+    if paper_agents.is_paper(run_dir):
+        if checkpoint_path is not None:
+            raise ValueError(f"{run_dir} is a released agent: it has one checkpoint, drop --checkpoint")
+        return paper_agents.load(str(run_dir), device)
     run_dir = pathlib.Path(run_dir)
     config_file = run_dir / "config.json"
     if not config_file.exists():
@@ -169,7 +178,8 @@ def _play_episode(env, policy: Policy, keep_frames: bool, top_down: viz.TopDown 
 
 def policy_arguments(parser: argparse.ArgumentParser) -> None:
     """Flags shared by the tools that play a run's agent or a random policy."""
-    parser.add_argument("source", help=f"a run folder (runs/<name>) or '{RANDOM}' (an untrained agent acting uniformly)")
+    parser.add_argument("source", help=f"a run folder (runs/<name>), '{RANDOM}' (an untrained agent acting "
+                        f"uniformly) or {paper_agents.PREFIX}<setting> (the paper's agent, e.g. paper:two_colour_1)")
     parser.add_argument("--checkpoint", type=pathlib.Path, default=None, help="default: the run's latest")
     parser.add_argument("--sample", action="store_true", help="sample actions instead of the greedy argmax")
     suite.difficulty_arguments(parser)
@@ -198,7 +208,22 @@ def policy_from_arguments(args: argparse.Namespace) -> tuple[str, dict, Policy, 
         raise ValueError(f"{args.source} was trained on {run_args.scenario} {task_kwargs}; drop the flags {clash or '--scenario'}")
     mode = "sample" if args.sample else "greedy"
     policy = Policy(agent, mode, args.seed)
+    if "layouts" in state:  # a paper agent plays the released mazes of the split
+        task_kwargs["layouts"] = state["layouts"][args.split]
+        return run_args.scenario, task_kwargs, policy, f"{args.source} (released, {mode})"
     return run_args.scenario, task_kwargs, policy, f"{pathlib.Path(args.source).name} @ {state['step']:,} steps ({mode})"
+
+
+def describe(task_kwargs: dict) -> str:
+    """Task arguments for a title: ``size=9``, with released mazes named as such rather than by their path."""
+    return " ".join(f"{k}={'released' if k == 'layouts' else v}" for k, v in task_kwargs.items())
+
+
+def output_folder(source: str) -> pathlib.Path:
+    """Where a tool writes for ``source`` by default: the run's folder, or ``runs/paper/<setting>`` for a paper agent."""
+    if paper_agents.is_paper(source):
+        return pathlib.Path("runs") / "paper" / paper_agents.get(source).name
+    return pathlib.Path(source)
 
 
 def threads_of(args: argparse.Namespace) -> int:

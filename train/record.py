@@ -78,7 +78,7 @@ def record(source_args: argparse.Namespace, episodes: int, out: pathlib.Path, fp
     path = video_path(out)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.stem}.tmp{path.suffix}")
-    header = f"{description} | {scenario} {task_kwargs} | {source_args.split}"
+    header = f"{description} | {scenario} {policy.describe(task_kwargs)} | {source_args.split}"
     field, scale, units = suite.paper_metric(scenario)
     summary = {"video": str(path), "source": source_args.source, "scenario": scenario, "task_kwargs": task_kwargs,
                "split": source_args.split, "fps": fps, "frames": 0, "metric_units": units, "episodes": []}

@@ -1,0 +1,155 @@
+"""The paper's agents in ViZDoom, as released: the other side of ``python -m mjmaze.train.paper_table``.
+
+    python bench/paper_agents_vizdoom.py RELEASED_CHECKOUT [--only labyrinth_9 two_colour_1] [--out FILE]
+
+RELEASED_CHECKOUT is a checkout of github.com/edbeeching/3d_control_deep_rl
+(its ``3dcdrl/scenarios/custom_scenarios/`` holds each maze's ``.cfg``/``.wad``,
+its ``3dcdrl/saved_models/`` the agents, which ``mjmaze.train.paper_agents`` loads).
+Needs ``pip install -e ".[bench]"`` (ViZDoom, and OpenCV for the released resize).
+
+Each agent plays its setting's mazes as ``mjmaze.train.evaluate`` plays them
+in mjmaze: the first 64 of ``train`` and the 64 of ``test``, each twice, the
+argmax action, the GRU wiped at each episode's start. ViZDoom runs as the
+released env ran it (``doom_environment.py``): the maze's released ``.cfg``,
+320x180, the ``--limit_actions`` buttons (left, right, forward, forward+left,
+forward+right), 4 tics per action, head-bob on, the frame resized to 112x64
+with ``cv2.INTER_AREA``. The metric is read off the rewards the released
+scripts pay: Labyrinth's exit (+1), Find-and-return's two +0.5 (the pillar,
+then the start), K-item's +0.5 per item in order; Two-colour's duration is
+4 tics per step, as mjmaze counts it. Writes ``--out`` (default
+``runs/paper/vizdoom.json``): one evaluation per agent, in ``evaluate``'s
+format, which ``paper_table --vizdoom`` puts beside mjmaze's.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import multiprocessing as mp
+import pathlib
+
+import numpy as np
+import torch
+
+from mjmaze import files, suite
+from mjmaze.train import paper_agents
+
+LIMITED_ACTIONS = ([True, False, False, False], [False, True, False, False], [False, False, True, False],
+                   [True, False, True, False], [False, True, True, False])  # left, right, fwd, fwd+left, fwd+right
+FRAME_SKIP = 4
+SIZE = (112, 64)
+PLAYS_PER_MAZE = 2
+BATCH = 16  # mazes played side by side (one network batch)
+
+
+def _game(cfg: pathlib.Path):
+    import vizdoom as vzd
+
+    game = vzd.DoomGame()
+    game.load_config(str(cfg))
+    game.set_screen_resolution(vzd.ScreenResolution.RES_320X180)  # as the released env sets it after the cfg
+    game.set_sound_enabled(False)
+    game.set_window_visible(False)
+    game.init()
+    return game
+
+
+def _frame(game) -> np.ndarray:
+    import cv2
+
+    screen = game.get_state().screen_buffer  # CRCGCB (the cfg): (3, 180, 320)
+    return cv2.resize(screen.transpose(1, 2, 0), SIZE, interpolation=cv2.INTER_AREA)
+
+
+def _metric(scenario: str, rewards: list[float], steps: int, num_items: int | None) -> float:
+    """The episode's metric in the units ``evaluate`` averages (success 0/1, item score, tics)."""
+    paid = sum(r > 0.25 for r in rewards)  # steps where a released script paid a +0.5 or +1
+    if scenario == "labyrinth":
+        return float(paid >= 1)
+    if scenario == "find_return":
+        return float(paid >= 2)
+    if scenario == "k_item":
+        return paid / num_items
+    return float(steps * FRAME_SKIP)  # two_colour: tics survived
+
+
+def play(job: tuple[str, str, str]) -> tuple[str, str, dict]:
+    """Plays one agent on one split's first 64 mazes, each twice; returns ``(name, split, result)``."""
+    name, split, checkout = job
+    torch.set_num_threads(1)
+    info = paper_agents.get(name)
+    _, agent, _ = paper_agents.load(name, paper_dir=checkout)
+    folder = pathlib.Path(checkout) / paper_agents.MAZES / info.maze_folder / split
+    field, scale, _ = suite.paper_metric(info.scenario)
+    num_items = info.difficulty if info.scenario == "k_item" else None
+    episodes = []
+    mazes = list(range(paper_agents.MAZES_PER_SPLIT))
+    for first in range(0, len(mazes), BATCH):
+        batch = mazes[first:first + BATCH]
+        games = [_game(folder / f"custom_scenario{index:03d}.cfg") for index in batch]
+        plays = [0] * len(games)
+        rewards = [[] for _ in games]
+        hidden = agent.initial_state(len(games))
+        starts = torch.ones(len(games), dtype=torch.bool)
+        live = list(range(len(games)))
+        while live:
+            frames = torch.from_numpy(np.stack([_frame(games[i]) for i in live]))
+            with torch.no_grad():
+                logits, _, new_hidden = agent.step(agent.features(frames), hidden[live], starts[live])
+            hidden[live] = new_hidden
+            starts[live] = False
+            for slot, i in enumerate(live):
+                rewards[i].append(games[i].make_action(LIMITED_ACTIONS[int(logits[slot].argmax())], FRAME_SKIP))
+                if games[i].is_episode_finished():
+                    steps = len(rewards[i])
+                    value = _metric(info.scenario, rewards[i], steps, num_items)
+                    episodes.append({"config_index": batch[i], "value": value * scale, "return": sum(rewards[i]),
+                                     "length": steps})
+                    plays[i] += 1
+                    rewards[i] = []
+                    starts[i] = True
+                    if plays[i] < PLAYS_PER_MAZE:
+                        games[i].new_episode()
+            live = [i for i in live if plays[i] < PLAYS_PER_MAZE]
+        for game in games:
+            game.close()
+    values = np.array([e["value"] for e in episodes])
+    return name, split, {
+        "metric": field, "value": float(values.mean()), "std": float(values.std()), "episodes": len(episodes),
+        "mean_return": float(np.mean([e["return"] for e in episodes])),
+        "mean_length": float(np.mean([e["length"] for e in episodes])),
+        "configs": sorted(e["config_index"] for e in episodes),
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("checkout", type=pathlib.Path, help="a checkout of the released repository")
+    parser.add_argument("--only", nargs="+", default=None, metavar="SETTING", help="e.g. labyrinth_9 two_colour_1")
+    parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("runs/paper/vizdoom.json"))
+    parser.add_argument("--processes", type=int, default=None, help="default: one per core")
+    args = parser.parse_args()
+    names = args.only or list(paper_agents.AGENTS)
+    for name in names:
+        paper_agents.get(name)  # a bad name fails before anything runs
+    if not (args.checkout / paper_agents.MAZES).is_dir():
+        raise SystemExit(f"error: {args.checkout} has no {paper_agents.MAZES}: pass a checkout of "
+                         f"{paper_agents.RELEASED_REPOSITORY}")
+    results = json.loads(args.out.read_text()) if args.out.exists() else {}  # kept: rerun only what is asked
+    jobs = [(name, split, str(args.checkout)) for name in names for split in ("train", "test")]
+    with mp.get_context("spawn").Pool(args.processes) as pool:
+        for name, split, result in pool.imap_unordered(play, jobs):
+            info = paper_agents.get(name)
+            entry = results.setdefault(name, {
+                "run": paper_agents.PREFIX + name, "engine": f"vizdoom {__import__('vizdoom').__version__}",
+                "step": info.observations, "scenario": info.scenario, "task_kwargs": info.task_kwargs,
+                "units": suite.paper_metric(info.scenario)[2]})
+            entry[split] = result
+            files.atomic_write_json(args.out, results)  # after each job: an interrupted run keeps what it did
+            print(f"{name} {split}: {result['value']:.3g} {entry['units']}, mean length {result['mean_length']:.0f} "
+                  f"steps", flush=True)
+    print(f"written: {args.out}")
+
+
+if __name__ == "__main__":
+    main()
