@@ -42,11 +42,12 @@ PLAYS_PER_MAZE = 2
 BATCH = 16  # mazes played side by side (one network batch)
 
 
-def _game(cfg: pathlib.Path):
+def _game(cfg: pathlib.Path, seed: int = 0):
     import vizdoom as vzd
 
     game = vzd.DoomGame()
     game.load_config(str(cfg))
+    game.set_seed(seed)  # Doom's random spawn heading and item draws: the same episodes on every run
     game.set_screen_resolution(vzd.ScreenResolution.RES_320X180)  # as the released env sets it after the cfg
     game.set_sound_enabled(False)
     game.set_window_visible(False)
@@ -86,7 +87,7 @@ def play(job: tuple[str, str, str]) -> tuple[str, str, dict]:
     mazes = list(range(paper_agents.MAZES_PER_SPLIT))
     for first in range(0, len(mazes), BATCH):
         batch = mazes[first:first + BATCH]
-        games = [_game(folder / f"custom_scenario{index:03d}.cfg") for index in batch]
+        games = [_game(folder / f"custom_scenario{index:03d}.cfg", seed=index) for index in batch]
         plays = [0] * len(games)
         rewards = [[] for _ in games]
         hidden = agent.initial_state(len(games))

@@ -124,3 +124,16 @@ def test_first_use_downloads_into_the_cache_once_and_checks_the_file(released, m
     with pytest.raises(FileNotFoundError, match="SHA-256 differs"):
         paper_agents.checkpoint_file(other)
     assert not (tmp_path / "cache" / "mjmaze" / "paper" / "agents" / other.checkpoint).exists()
+
+
+def test_curves_draw_a_paper_agents_level_beside_runs(released, tmp_path):
+    from mjmaze.train import curves
+
+    with pytest.raises(SystemExit, match="no evaluation yet: pass --evaluate"):
+        curves.main(["paper:find_return_7", "--out", str(tmp_path / "c.png")])
+    evaluate.evaluate("paper:find_return_7", num_envs=4, num_configs=4, progress=False)  # runs/paper/find_return_7
+    curves.main(["paper:find_return_7", "--out", str(tmp_path / "c.png")])
+    (group,) = json.loads((tmp_path / "c.json").read_text())
+    saved = json.loads((tmp_path / "runs" / "paper" / "find_return_7" / "eval.json").read_text())
+    assert group["released"] == {split: saved[split]["curve_value"] for split in ("train", "test")}
+    assert (tmp_path / "c.png").stat().st_size > 1000

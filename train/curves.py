@@ -27,7 +27,7 @@ from tqdm import tqdm
 
 from mjmaze import files, registry
 
-from . import checkpoint, evaluate
+from . import checkpoint, evaluate, paper_agents
 from .analysis import save_figure
 
 BINS = 40
@@ -131,8 +131,29 @@ def evaluations(runs: list[dict]) -> dict:
     return out
 
 
-def curves(run_dirs: list[pathlib.Path], bins: int = BINS, each_run: bool = False) -> list[dict]:
-    """One curve per group of seeds (or, with ``each_run``, per run, named by its folder), in the order they first appear."""
+def released_group(source: str) -> dict:
+    """One of the paper's agents (``paper:<setting>``) as a group: its greedy evaluation in mjmaze, drawn as lines."""
+    info = paper_agents.get(source)
+    path = evaluate.default_output(source)
+    if not path.exists():
+        raise FileNotFoundError(f"{source} has no evaluation yet: pass --evaluate, or run "
+                                f"python -m mjmaze.train.evaluate {source}")
+    result = json.loads(path.read_text())
+    declared = registry.get(info.scenario)
+    return {"label": f"{source} (the paper's agent, {info.observations / 1e6:.0f}M)", "scenario": info.scenario,
+            "setting": f"{info.scenario} {declared.difficulty}={info.difficulty}", "units": declared.curve_units,
+            "eval_units": declared.metric_units, "runs": [source],
+            "released": {split: result[split]["curve_value"] for split in ("train", "test")}}
+
+
+def curves(run_dirs: list[pathlib.Path | str], bins: int = BINS, each_run: bool = False) -> list[dict]:
+    """One curve per group of seeds (or, with ``each_run``, per run, named by its folder), in the order they first appear.
+
+    A ``paper:<setting>`` among ``run_dirs`` adds the paper's agent's greedy
+    train and test levels in mjmaze (:func:`released_group`) to its scenario's panel.
+    """
+    released = [released_group(str(source)) for source in run_dirs if paper_agents.is_paper(source)]
+    run_dirs = [source for source in run_dirs if not paper_agents.is_paper(source)]
     groups: dict[tuple, list[dict]] = {}
     for run_dir in run_dirs:
         run = read_run(pathlib.Path(run_dir))
@@ -149,7 +170,7 @@ def curves(run_dirs: list[pathlib.Path], bins: int = BINS, each_run: bool = Fals
             "runs": [r["dir"] for r in runs], "training": binned(runs, bins), "evaluations": evaluations(runs),
             "paper": {"step": [s for s, _ in paper], "value": [v for _, v in paper]},
         })
-    return result
+    return result + released
 
 
 def figure(groups: list[dict], title: str = "") -> Figure:
@@ -162,6 +183,10 @@ def figure(groups: list[dict], title: str = "") -> Figure:
     for group in groups:
         ax = axes[scenarios.index(group["scenario"])]
         colour = next(colours)
+        if "released" in group:  # one of the paper's agents: its level after 200M observations, as lines
+            ax.axhline(group["released"]["train"], color=colour, linewidth=1.2, label=f"{group['label']}: greedy, train")
+            ax.axhline(group["released"]["test"], color=colour, linewidth=1.2, linestyle="--", label="... and test")
+            continue
         seeds = len(group["runs"])
         name = f"{group['label']} ({seeds} seed{'s' * (seeds != 1)})"
         train = group["training"]
@@ -209,7 +234,7 @@ def write(groups: list[dict], out: pathlib.Path, title: str = "") -> pathlib.Pat
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("runs", nargs="+", type=pathlib.Path, help="run folders")
+    parser.add_argument("runs", nargs="+", help="run folders, and paper:<setting> for the paper's agent's level")
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("runs/curves.png"))
     parser.add_argument("--evaluate", action="store_true", help="evaluate kept checkpoints not evaluated yet")
     parser.add_argument("--num-envs", type=int, default=16, help="parallel envs for --evaluate (must divide 64)")
@@ -222,12 +247,19 @@ def main(argv: list[str] | None = None) -> None:
     try:
         if args.evaluate:
             for run_dir in args.runs:
-                evaluate_checkpoints(run_dir, args.num_envs, args.torch_threads)
+                if paper_agents.is_paper(run_dir):
+                    if not evaluate.default_output(run_dir).exists():
+                        evaluate.evaluate(run_dir, num_envs=args.num_envs, torch_threads=args.torch_threads)
+                else:
+                    evaluate_checkpoints(pathlib.Path(run_dir), args.num_envs, args.torch_threads)
         groups = curves(args.runs, args.bins, each_run=args.each_run)
     except (checkpoint.CheckpointError, FileNotFoundError, ValueError) as error:
         raise SystemExit(f"error: {error}") from None
     write(groups, args.out)
     for g in groups:
+        if "released" in g:
+            print(f"{g['label']}: greedy train/test {g['released']['train']:.3g}/{g['released']['test']:.3g} ({g['units']})")
+            continue
         ev = g["evaluations"]
         # The greedy figures are in the evaluation's units (Table 2's), which differ from the curve's for K-item.
         last = (f"; last greedy train/test {ev['train_mean'][-1]:.3g}/{ev['test_mean'][-1]:.3g} ({g['eval_units']})"
