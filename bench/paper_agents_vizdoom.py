@@ -1,6 +1,7 @@
 """The paper's agents in ViZDoom, as released: the other side of ``python -m mjmaze.train.paper_table``.
 
     python bench/paper_agents_vizdoom.py RELEASED_CHECKOUT [--only labyrinth_9 two_colour_1] [--out FILE]
+    python bench/paper_agents_vizdoom.py RELEASED_CHECKOUT --agreement labyrinth_7   # the same action at the same pose?
 
 RELEASED_CHECKOUT is a checkout of github.com/edbeeching/3d_control_deep_rl
 (its ``3dcdrl/scenarios/custom_scenarios/`` holds each maze's ``.cfg``/``.wad``,
@@ -37,6 +38,7 @@ from mjmaze.train import paper_agents
 LIMITED_ACTIONS = ([True, False, False, False], [False, True, False, False], [False, False, True, False],
                    [True, False, True, False], [False, True, True, False])  # left, right, fwd, fwd+left, fwd+right
 FRAME_SKIP = 4
+_POSE = ("POSITION_X", "POSITION_Y", "ANGLE")
 SIZE = (112, 64)
 PLAYS_PER_MAZE = 2
 BATCH = 16  # mazes played side by side (one network batch)
@@ -123,13 +125,72 @@ def play(job: tuple[str, str, str]) -> tuple[str, str, dict]:
     }
 
 
+def agreement(name: str, checkout: str, mazes: int = 8) -> float:
+    """How often the agent chooses, on mjmaze's frame, the action it chose on ViZDoom's frame at the same pose.
+
+    The agent plays the first ``mazes`` test mazes greedily in ViZDoom; each of
+    its poses is then set in mjmaze (head-bob off: its phase is ViZDoom's own)
+    and mjmaze's frame goes through the same network, its memory fed by
+    mjmaze's frames along the same path. 1.0 would mean the agent cannot tell
+    the engines apart along its own path. Labyrinth only: the other
+    scenarios' things move or appear at random, so their poses alone do not fix the view.
+    """
+    import math
+
+    import vizdoom as vzd
+
+    import mjmaze
+
+    info = paper_agents.get(name)
+    _, agent, _ = paper_agents.load(name, paper_dir=checkout)
+    folder = pathlib.Path(checkout) / paper_agents.MAZES / info.maze_folder / "test"
+    env = mjmaze.load(info.scenario, task_kwargs={**info.task_kwargs, "layouts": str(folder), "head_bob": False})
+    same = []
+    for index in range(mazes):
+        maze = json.loads((folder / f"custom_scenario{index:03d}.json").read_text())
+        centre = np.mean(np.array(maze["exterior"], dtype=float), axis=0)  # mjmaze centres the maze on (0, 0)
+        game = _game(folder / f"custom_scenario{index:03d}.cfg", seed=index)
+        path = []
+        hidden, start = agent.initial_state(1), torch.ones(1, dtype=torch.bool)
+        while not game.is_episode_finished():
+            x, y, angle = (game.get_game_variable(getattr(vzd.GameVariable, v)) for v in _POSE)
+            with torch.no_grad():
+                logits, _, hidden = agent.step(agent.features(torch.from_numpy(_frame(game)[None])), hidden, start)
+            start[:] = False
+            path.append(((x - centre[0]) / 128, (y - centre[1]) / 128, math.radians(angle), int(logits.argmax())))
+            game.make_action(LIMITED_ACTIONS[path[-1][3]], FRAME_SKIP)
+        game.close()
+        env.reset()
+        while env.task.config.index != index:
+            env.reset()
+        hidden, start = agent.initial_state(1), torch.ones(1, dtype=torch.bool)
+        for x, y, yaw, action in path:
+            env.physics.set_agent_pose(x, y, yaw)
+            env.physics.forward()
+            frame = np.ascontiguousarray(env.task.get_observation(env.physics)["pixels"])
+            with torch.no_grad():
+                logits, _, hidden = agent.step(agent.features(torch.from_numpy(frame[None])), hidden, start)
+            start[:] = False
+            same.append(int(logits.argmax()) == action)
+    env.task.close()
+    return float(np.mean(same))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("checkout", type=pathlib.Path, help="a checkout of the released repository")
     parser.add_argument("--only", nargs="+", default=None, metavar="SETTING", help="e.g. labyrinth_9 two_colour_1")
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("runs/paper/vizdoom.json"))
     parser.add_argument("--processes", type=int, default=None, help="default: one per core")
+    parser.add_argument("--agreement", metavar="SETTING", default=None,
+                        help="instead: how often a Labyrinth agent acts alike on both engines' frames at the same poses")
     args = parser.parse_args()
+    if args.agreement:
+        if paper_agents.get(args.agreement).scenario != "labyrinth":
+            raise SystemExit("error: --agreement takes a Labyrinth agent (labyrinth_7 .. labyrinth_13)")
+        print(f"{args.agreement}: the same action at {agreement(args.agreement, str(args.checkout)):.1%} of the "
+              "poses of its ViZDoom episodes (first 8 test mazes)")
+        return
     names = args.only or list(paper_agents.AGENTS)
     for name in names:
         paper_agents.get(name)  # a bad name fails before anything runs

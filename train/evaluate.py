@@ -117,6 +117,7 @@ def evaluate_random(args: Args, num_envs: int = 16, out: str | pathlib.Path | No
     check_sizes(num_envs, num_configs)
     result = {
         "run": "random", "checkpoint": None, "step": 0, "scenario": args.scenario,
+        "env_id": registry.get(args.scenario).gym_id,
         "task_kwargs": args.task_kwargs(), "units": suite.paper_metric(args.scenario)[2],
     }
     for split in ("train", "test"):
@@ -149,6 +150,7 @@ def _evaluate(run_dir, checkpoint_path, num_envs, torch_device, out, num_configs
         "checkpoint": state["path"],
         "step": int(state["step"]),
         "scenario": args.scenario,
+        "env_id": registry.get(args.scenario).gym_id,  # its version: what the frames and rules were
         "task_kwargs": args.task_kwargs(),
         "units": suite.paper_metric(args.scenario)[2],
     }

@@ -69,6 +69,7 @@ def rows(mjmaze_results: dict[str, dict], vizdoom_results: dict[str, dict]) -> l
         doom = vizdoom_results.get(name)
         row = {
             "setting": name, "scenario": info.scenario, "difficulty": info.difficulty, "units": result["units"],
+            "env_id": result.get("env_id"),
             "paper": None if paper is None else {"train": paper[0], "train_std": paper[1],
                                                  "test": paper[2], "test_std": paper[3]},
             "mjmaze": {split: result[split]["value"] for split in ("train", "test")},

@@ -193,8 +193,10 @@ class MazeTask(base.Task):
     scenario: str = ""
     #: The colours of its walls, floor and ceiling (the released Doom textures').
     room: mjcf.Room = mjcf.STONE_ROOM
-    #: Whether the released runs saw the pistol (their .cfg's ``render_weapon``): drawn in the "textured" style.
-    pistol: bool = True
+    #: Whether frames show Doom's pistol (in the "textured" style). The released .cfg files say
+    #: ``render_weapon = true``, but every released map's ENTER script calls ``ClearInventory()``:
+    #: ViZDoom drew no weapon in any of the paper's scenarios, so none does here (the ``-v0`` ids drew one).
+    pistol: bool = False
 
     def __init__(
         self,

@@ -16,6 +16,11 @@ Arguments
     ``size`` (5, 7, 9, 11, 13) and the common task arguments.
 Metric
     ``success``: target found and return reached; ``target_found``.
+Version History
+    * v1 (2026-11-25): no pistol drawn: the released maps' ENTER scripts clear
+      the inventory, so ViZDoom never drew one (found with the paper's agents).
+    * v0 (2026-11-23): initial release; frames, motion and rules calibrated
+      against ViZDoom through 2026-11-24 under the same id (CHANGELOG.md).
 """
 
 from __future__ import annotations
@@ -92,7 +97,7 @@ class FindReturn(base.MazeTask):
 SCENARIO = registry.Scenario(
     name="find_return",
     task=FindReturn,
-    gym_id="mjmaze/FindReturn-v0",
+    gym_id="mjmaze/FindReturn-v1",
     seed_code=2,
     difficulty="size",
     difficulties=SIZES,

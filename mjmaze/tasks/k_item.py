@@ -21,6 +21,11 @@ Metric
 The collection order is item kind 1, then 2, ... by the released files' colour
 codes: green, red, blue, cyan, magenta, yellow, then two greys, which also
 differ in shape (:data:`KINDS`).
+Version History
+    * v1 (2026-11-25): no pistol drawn: the released maps' ENTER scripts clear
+      the inventory, so ViZDoom never drew one (found with the paper's agents).
+    * v0 (2026-11-23): initial release; frames, motion and rules calibrated
+      against ViZDoom through 2026-11-24 under the same id (CHANGELOG.md).
 """
 
 from __future__ import annotations
@@ -120,7 +125,7 @@ class KItem(base.MazeTask):
 SCENARIO = registry.Scenario(
     name="k_item",
     task=KItem,
-    gym_id="mjmaze/KItem-v0",
+    gym_id="mjmaze/KItem-v1",
     seed_code=3,
     difficulty="num_items",
     difficulties=NUM_ITEMS,

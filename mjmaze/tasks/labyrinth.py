@@ -15,6 +15,11 @@ Arguments
     ``first_config``, ``action_set``, ``width``, ``height``, ``random``.
 Metric
     ``success``: whether the exit was reached (success rate = mean over episodes).
+Version History
+    * v1 (2026-11-25): no pistol drawn: the released maps' ENTER scripts clear
+      the inventory, so ViZDoom never drew one (found with the paper's agents).
+    * v0 (2026-11-23): initial release; frames, motion and rules calibrated
+      against ViZDoom through 2026-11-24 under the same id (CHANGELOG.md).
 """
 
 from __future__ import annotations
@@ -71,7 +76,7 @@ class Labyrinth(base.MazeTask):
 SCENARIO = registry.Scenario(
     name="labyrinth",
     task=Labyrinth,
-    gym_id="mjmaze/Labyrinth-v0",
+    gym_id="mjmaze/Labyrinth-v1",
     seed_code=1,
     difficulty="size",
     difficulties=SIZES,

@@ -3,8 +3,7 @@
 Action Space
     ``DiscreteArray(5)`` (``action_set="extended"``: 8), as in Labyrinth.
 Observation
-    ``pixels``: uint8 RGB ``(64, 112, 3)``, without the pistol (the released
-    Two-colour .cfg has ``render_weapon = false``).
+    ``pixels``: uint8 RGB ``(64, 112, 3)``, no weapon (as every scenario).
 Rules
     A tall totem at the maze centre is red or green, 50/50 per episode. 10 green
     and 10 red items start at random positions, uniform over the floor the agent
@@ -36,6 +35,9 @@ Arguments
     it until it has stepped clear (as ZDoom lets overlapping actors move apart).
 Metric
     ``duration``: tics survived (max 2100); also ``health`` and ``totem_green``.
+Version History
+    * v0 (2026-11-23): initial release; frames, motion and rules calibrated
+      against ViZDoom through 2026-11-24 under the same id (CHANGELOG.md).
 """
 
 from __future__ import annotations
@@ -107,7 +109,6 @@ class TwoColour(base.MazeTask):
 
     scenario = "two_colour"
     room = mjcf.SLIME_ROOM
-    pistol = False  # the released .cfg: render_weapon = false
     objects = (TOTEM, *ITEMS)
 
     def __init__(
