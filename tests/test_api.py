@@ -5,8 +5,6 @@ import warnings
 import gymnasium
 import numpy as np
 import pytest
-from dm_control.rl import control
-from dm_env import specs
 from gymnasium.utils.env_checker import check_env
 
 import mjmaze

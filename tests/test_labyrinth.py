@@ -8,7 +8,7 @@ import pytest
 import mjmaze
 from mjmaze.tasks import base, labyrinth
 
-from conftest import FORWARD, TURN_LEFT, TURN_RIGHT, find_cell, open_run, place, yaw_difference
+from conftest import FORWARD, TURN_LEFT, TURN_RIGHT, find_cell, place
 
 
 def test_exit_pays_one_and_ends_the_episode(labyrinth9):
