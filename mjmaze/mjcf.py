@@ -61,6 +61,18 @@ TALL_RED_COLUMN_RGBA = (0.73, 0.06, 0.04, 1.0)
 #: red items), averaged over their blink, on a floor cylinder of their size.
 GREEN_ARMOUR_RGBA = (0.52, 0.63, 0.39, 1.0)
 RED_ARMOUR_RGBA = (0.73, 0.31, 0.30, 1.0)
+#: The green armour's sprite (Freedoom's ARM1, 542 pixels) read from top to
+#: bottom as ``(share of its pixels, their mean colour)``: the grey shoulder
+#: plates, the green chest, the dark lower edge. ViZDoom's frames of the
+#: released maps show it so (51% grey, 26% vivid green: docs/paper_agents.md);
+#: drawn as horizontal bands on the object's side (:attr:`ObjectGeom.bands`),
+#: the olive mean alone hid the vivid part agents look for.
+GREEN_ARMOUR_BANDS = (
+    (0.52, (0.308, 0.297, 0.281)),
+    (0.28, (0.199, 0.422, 0.158)),
+    (0.20, (0.157, 0.136, 0.074)),
+)
+BAND_TEXELS = 100  # texture rows for an object's bands (their shares are in hundredths)
 #: Ambient light everywhere, then a lamp at the eye adding ``LAMP_DIFFUSE x cos / (0.05 + d)``
 #: at ``d`` metres: Doom's light diminishing at sector light 160, which ViZDoom
 #: draws as 27 + 12 / d grey levels on a ``STONE2`` wall ``d`` map cells ahead.
@@ -105,6 +117,12 @@ class ObjectGeom:
     placed by writing ``model.geom_pos``: a body each made every ``mj_step``
     about twice as dear with Two-colour's 90 items (43 against 21 us per 4 tics).
     ``z`` is the height of the geom's centre. Objects start hidden.
+
+    ``bands`` (textured style only): the sprite's pixels from top to bottom as
+    ``(share, rgb)`` bands, drawn as a texture on the side of a cylinder, scaled
+    so that their mean is ``rgba`` (the calibrated mean colour, which maps and
+    the flat style show). Bands vary only with height: a cylinder shows the same
+    side from every direction, as a sprite, where a left-right pattern would turn.
     """
 
     name: str
@@ -113,6 +131,21 @@ class ObjectGeom:
     rgba: tuple[float, float, float, float]
     z: float
     collides: bool = False
+    bands: tuple[tuple[float, tuple[float, float, float]], ...] = ()
+
+    def band_texels(self) -> tuple[np.ndarray, float]:
+        """``(texels (BAND_TEXELS, 1, 3) uint8, gain)``: the bands as texture rows
+        relative to their mean, and the factor on ``rgba`` that keeps texels <= 1."""
+        shares = np.array([share for share, _ in self.bands])
+        colours = np.array([rgb for _, rgb in self.bands])
+        if abs(shares.sum() - 1) > 1e-6:
+            raise ValueError(f"{self.name}: band shares must sum to 1, got {shares.sum()}")
+        relative = colours / (shares @ colours)
+        gain = float(relative.max())
+        rows = np.repeat(np.arange(len(shares)), np.round(shares * BAND_TEXELS).astype(int))[:BAND_TEXELS]
+        rows = np.concatenate([rows, np.full(BAND_TEXELS - len(rows), len(shares) - 1)])
+        texels = np.round(relative[rows] / gain * 255).astype(np.uint8)
+        return texels[:, None, :], gain
 
 
 def floor_thing(name: str, shape: str, width: float, height: float, rgba, collides: bool = False) -> ObjectGeom:
@@ -219,7 +252,18 @@ def build_xml(
             size=f"{hx} {hy} {WALL_HEIGHT / 2}", pos=f"{x} {y} {WALL_HEIGHT / 2}",
         )
     for obj in objects:  # see ObjectGeom
-        attrs = dict(name=obj.name, type=obj.type, size=" ".join(map(str, obj.size)), rgba=" ".join(map(str, obj.rgba)))
+        rgba = obj.rgba
+        attrs = dict(name=obj.name, type=obj.type, size=" ".join(map(str, obj.size)))
+        if obj.bands and visual_style == "textured":
+            # GL multiplies the texels by the geom's colour (a geom colour other
+            # than the default overrides the material's, in MuJoCo and MuJoCo Warp).
+            texels, gain = obj.band_texels()
+            ET.SubElement(asset, "texture", name=obj.name, type="2d", builtin="flat",
+                          width=str(texels.shape[1]), height=str(texels.shape[0]), rgb1="1 1 1")
+            ET.SubElement(asset, "material", name=obj.name, texture=obj.name, specular="0", shininess="0", reflectance="0")
+            attrs["material"] = obj.name
+            rgba = (*np.minimum(np.array(obj.rgba[:3]) * gain, 1.0).round(4).tolist(), obj.rgba[3])
+        attrs["rgba"] = " ".join(map(str, rgba))
         if obj.collides:
             body = ET.SubElement(worldbody, "body", name=obj.name, mocap="true", pos=f"0 0 {obj.z}")
             ET.SubElement(body, "geom", **{"class": "item"}, contype="1", conaffinity="1", **attrs)
@@ -330,9 +374,11 @@ def _add_distance_falloff(root: ET.Element) -> None:
     )
 
 
-def paint_textures(model: mujoco.MjModel) -> None:
-    """Fills the wall and floor textures of a ``"textured"`` model (a fixed pattern, the same everywhere)."""
-    for name, texels in (("wall", _brick_texels()), ("floor", _tile_texels())):
+def paint_textures(model: mujoco.MjModel, objects: Sequence[ObjectGeom] = ()) -> None:
+    """Fills the textures of a ``"textured"`` model: walls and floor (a fixed
+    pattern, the same everywhere) and the bands of ``objects`` that have them."""
+    banded = [(obj.name, obj.band_texels()[0]) for obj in objects if obj.bands]
+    for name, texels in (("wall", _brick_texels()), ("floor", _tile_texels()), *banded):
         texture = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXTURE, name)
         if texture < 0:
             continue

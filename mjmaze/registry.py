@@ -25,7 +25,7 @@ class Scenario:
     Attributes:
       name: what :func:`mjmaze.load` takes, e.g. ``"labyrinth"``.
       task: the :class:`mjmaze.tasks.base.MazeTask` subclass.
-      gym_id: the gymnasium id, e.g. ``"mjmaze/Labyrinth-v1"``.
+      gym_id: the gymnasium id, e.g. ``"mjmaze/Labyrinth-v2"``.
       seed_code: an integer that enters every maze seed of the scenario. Fixed
         forever: changing it changes every published configuration. Distinct
         across scenarios.

@@ -4,7 +4,7 @@
 gymnasium vector env whose observations, rewards, flags and ``info`` are torch
 tensors on ``device``; reached from the registry by one word::
 
-    envs = gymnasium.make_vec("mjmaze/Labyrinth-v1", num_envs=4096,
+    envs = gymnasium.make_vec("mjmaze/Labyrinth-v2", num_envs=4096,
                               vectorization_mode="vector_entry_point", backend="warp", size=9)
 
 It plays the same task as the CPU envs: the same configurations (splits,
@@ -107,7 +107,7 @@ def build_model(task: base.MazeTask) -> tuple[mujoco.MjModel, np.ndarray, np.nda
             twin.set("contype", "1")
             twin.set("conaffinity", "1")
     model = mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
-    mjcf.paint_textures(model)
+    mjcf.paint_textures(model, task.objects)
     for mesh, config in first_of_layout.items():
         mesh_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MESH, f"{mjcf.WALL_MESH}_{mesh}")
         mjcf.write_wall_mesh(model, mesh_id, config.h_walls, config.v_walls, layout.cell_size)

@@ -16,6 +16,10 @@ Arguments
 Metric
     ``success``: whether the exit was reached (success rate = mean over episodes).
 Version History
+    * v2 (2026-11-25): the exit shows the green armour's sprite as bands (grey
+      plates, the vivid green chest, a dark lower edge) around the same mean
+      colour; the released agents' episodes were longest where the olive
+      mean hid the green (docs/paper_agents.md).
     * v1 (2026-11-25): no pistol drawn: the released maps' ENTER scripts clear
       the inventory, so ViZDoom never drew one (found with the paper's agents).
     * v0 (2026-11-23): initial release; frames, motion and rules calibrated
@@ -38,10 +42,14 @@ STEP_REWARD = -0.0001 * base.TICS_PER_STEP
 # on the floor, 40 x 16 map units (a 31 x 17 sprite), i.e. 0.12 m in radius and
 # 0.125 m high. A cylinder shows the same width from every side, as a sprite.
 # How small it is decides how far off the agent can spot it (docs/objects.md).
-# Its colour is the armour's as ViZDoom draws it, blinking, at the released
-# light: a dull olive, little brighter than the walls (docs/look.md).
+# Its mean colour is the armour's as ViZDoom draws it, blinking, at the
+# released light, a dull olive (docs/look.md); its side shows the sprite's
+# grey plates, vivid green chest and dark edge as bands around that mean.
 EXIT_RADIUS, EXIT_HEIGHT = 0.12, 16 * base.MAP_UNIT
-EXIT = mjcf.ObjectGeom("exit", "cylinder", (EXIT_RADIUS, EXIT_HEIGHT / 2), mjcf.GREEN_ARMOUR_RGBA, z=EXIT_HEIGHT / 2)
+EXIT = mjcf.ObjectGeom(
+    "exit", "cylinder", (EXIT_RADIUS, EXIT_HEIGHT / 2), mjcf.GREEN_ARMOUR_RGBA, z=EXIT_HEIGHT / 2,
+    bands=mjcf.GREEN_ARMOUR_BANDS,
+)
 
 
 class Labyrinth(base.MazeTask):
@@ -76,7 +84,7 @@ class Labyrinth(base.MazeTask):
 SCENARIO = registry.Scenario(
     name="labyrinth",
     task=Labyrinth,
-    gym_id="mjmaze/Labyrinth-v1",
+    gym_id="mjmaze/Labyrinth-v2",
     seed_code=1,
     difficulty="size",
     difficulties=SIZES,
