@@ -21,19 +21,16 @@ TRITON ?= triton==3.7.1
 # Where pip looks for torch; empty = PyPI (whose Linux torch is the multi-GB
 # CUDA build). Without an NVIDIA GPU: TORCH_INDEX=https://download.pytorch.org/whl/cpu
 TORCH_INDEX ?=
-# The main job: A2C on Labyrinth 5x5, sized to finish within ~15 minutes on 2 CPU cores.
-RUN_STEPS ?= 1000000
-# Expanded once (:=), so the train and evaluate lines name the same run.
-ifndef RUN_NAME
-RUN_NAME := labyrinth5_$(shell date +%Y%m%d-%H%M%S)
-endif
+# The main job (mjmaze.train.first_run): A2C on Labyrinth 5x5 in ~10 minutes on
+# 2 CPU cores, then a greedy evaluation beside a random policy, a learning
+# curve and a video. RUN_ARGS=--paper trains with the paper's configuration.
+RUN_STEPS ?= 800000
+RUN_ARGS ?=
 
 .PHONY: run test bench setup system-deps test-deps clean
 
 run: system-deps $(VENV)/.stamp-torch $(VENV)/.stamp-train,viz
-	$(PY) -m mjmaze.train.a2c --scenario labyrinth --size 5 --total-steps $(RUN_STEPS) \
-	  --run-name $(RUN_NAME) --checkpoint-every 250000
-	$(PY) -m mjmaze.train.evaluate runs/$(RUN_NAME)
+	$(PY) -m mjmaze.train.first_run --total-steps $(RUN_STEPS) $(RUN_ARGS)
 
 test: system-deps test-deps $(VENV)/.stamp-torch $(VENV)/.stamp-triton $(VENV)/.stamp-train,dev
 	$(PY) -m pytest -q

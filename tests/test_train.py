@@ -97,7 +97,9 @@ def test_the_rollouts_own_graph_gives_the_gradients_of_a_recomputed_unroll():
 
 def test_two_update_smoke_run_writes_a_run_folder(tmp_path):
     run = a2c.train(tiny(tmp_path, total_steps=32))
-    assert json.loads((run / "config.json").read_text())["size"] == 5
+    config = json.loads((run / "config.json").read_text())
+    assert config["size"] == 5
+    assert config["env_id"] == "mjmaze/Labyrinth-v2"  # the version the run trained on
     lines = [json.loads(line) for line in (run / "metrics.jsonl").read_text().splitlines()]
     assert [line["step"] for line in lines] == [16, 32]
     assert all(math.isfinite(line["policy_loss"]) and line["sps"] > 0 for line in lines)

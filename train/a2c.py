@@ -83,7 +83,8 @@ def train(args: Args) -> pathlib.Path:
     task_kwargs = args.task_kwargs()
     run_dir = pathlib.Path(args.runs_dir) / args.name()
     checkpoint_dir = run_dir / "checkpoints"
-    config = dataclasses.asdict(args)
+    # The env id names the scenario's version (look, motion, rules, seeds), as gymnasium's ids do.
+    config = dataclasses.asdict(args) | {"env_id": registry.get(args.scenario).gym_id}
     if run_dir.exists() and checkpoint.checkpoints(checkpoint_dir) and not args.resume:
         raise FileExistsError(f"{run_dir} already holds a run: pass --resume to go on, or another --run-name")
     state = None

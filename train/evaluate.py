@@ -151,6 +151,8 @@ def _evaluate(run_dir, checkpoint_path, num_envs, torch_device, out, num_configs
         "step": int(state["step"]),
         "scenario": args.scenario,
         "env_id": registry.get(args.scenario).gym_id,  # its version: what the frames and rules were
+        # What the run trained on (config.json; runs from before ids were saved say nothing).
+        "trained_env_id": policy.trained_env_id(run_dir),
         "task_kwargs": args.task_kwargs(),
         "units": suite.paper_metric(args.scenario)[2],
     }

@@ -28,6 +28,14 @@ from .model import Agent
 RANDOM = "random"
 
 
+def trained_env_id(run_dir: str | pathlib.Path) -> str | None:
+    """The env id (its version) a run was trained on, from its ``config.json``; a paper agent's is ViZDoom's."""
+    if paper_agents.is_paper(run_dir):
+        return "vizdoom (the paper's released agent)"
+    config_file = pathlib.Path(run_dir) / "config.json"
+    return json.loads(config_file.read_text()).get("env_id") if config_file.exists() else None
+
+
 def load_run(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | None = None,
              device: torch.device | str = "cpu") -> tuple[Args, Agent, dict]:
     """``(args, agent in eval mode, checkpoint state)`` of a run; default: its latest checkpoint.
@@ -45,7 +53,9 @@ def load_run(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | 
     if not config_file.exists():
         raise FileNotFoundError(f"{run_dir} is not a training run (no config.json)")
     # A run saved before a setting existed ran without it (checkpoint.MISSING_MEANS).
-    args = Args(**{**checkpoint.MISSING_MEANS, **json.loads(config_file.read_text())})
+    saved = {**checkpoint.MISSING_MEANS, **json.loads(config_file.read_text())}
+    # Keys that are not settings (env_id: what the run was trained on) stay in config.json.
+    args = Args(**{k: v for k, v in saved.items() if k in {f.name for f in dataclasses.fields(Args)}})
     if checkpoint_path is None:
         found = checkpoint.checkpoints(run_dir / "checkpoints")
         if not found:

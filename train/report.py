@@ -33,7 +33,7 @@ from . import curves
 
 # The paper's Table 2 is each scenario's ``paper_results`` in mjmaze.registry.
 PAPER_STEPS = 200_000_000
-CSV_FIELDS = ("scenario", "difficulty_name", "difficulty", "num_configs", "units", "seeds", "evaluated", "steps",
+CSV_FIELDS = ("scenario", "env_ids", "difficulty_name", "difficulty", "num_configs", "units", "seeds", "evaluated", "steps",
               "episodes",
               "train_mean", "train_std", "test_mean", "test_std",
               "paper_train_mean", "paper_train_std", "paper_test_mean", "paper_test_std")
@@ -45,6 +45,7 @@ def collect(sweep_dir: pathlib.Path) -> tuple[list[dict], list[pathlib.Path]]:
     if not run_dirs:
         raise FileNotFoundError(f"no run folders (with config.json) in {sweep_dir}")
     groups: dict[tuple, list[tuple[dict, dict | None]]] = {}
+    env_ids: dict[str, set[str]] = {}  # the versions the runs trained on, per scenario
     for run_dir in run_dirs:
         config = json.loads((run_dir / "config.json").read_text())
         eval_file = run_dir / "eval.json"
@@ -52,6 +53,7 @@ def collect(sweep_dir: pathlib.Path) -> tuple[list[dict], list[pathlib.Path]]:
         scenario = config["scenario"]
         key = (scenario, config.get(registry.get(scenario).difficulty), config.get("num_configs"))
         groups.setdefault(key, []).append((config, result))
+        env_ids.setdefault(scenario, set()).add(config.get("env_id", "id not recorded"))
     rows = []
     for (scenario, difficulty, num_configs), runs in sorted(groups.items(), key=lambda kv: _order(kv[0])):
         evaluated = [r for _, r in runs if r is not None]
@@ -61,7 +63,7 @@ def collect(sweep_dir: pathlib.Path) -> tuple[list[dict], list[pathlib.Path]]:
         rows.append({
             "scenario": scenario, "difficulty_name": registry.get(scenario).difficulty, "difficulty": difficulty,
             "num_configs": num_configs, "units": suite.paper_metric(scenario)[2], "seeds": len(runs),
-            "evaluated": len(evaluated), "steps": min((r["step"] for r in evaluated), default=None),
+            "env_ids": " ".join(sorted(env_ids[scenario])), "evaluated": len(evaluated), "steps": min((r["step"] for r in evaluated), default=None),
             "episodes": min((r["test"]["episodes"] for r in evaluated), default=None),
             "train_mean": float(train.mean()) if len(train) else None,
             "train_std": float(train.std()) if len(train) else None,
@@ -95,7 +97,9 @@ def markdown(rows: list[dict], sweep_dir: pathlib.Path) -> str:
         units = suite.paper_metric(scenario)[2]
         scenario_rows = [r for r in rows if r["scenario"] == scenario]
         with_configs = any(r["num_configs"] for r in scenario_rows)
-        lines += [f"## {scenario} ({units})", ""]
+        ids = scenario_rows[0]["env_ids"]
+        mixed = " (runs of different versions: compare with care)" if " " in ids else ""
+        lines += [f"## {scenario} ({units}), trained on `{ids}`{mixed}", ""]
         header = [registry.get(scenario).difficulty, *(["training mazes"] if with_configs else []), "seeds", "steps",
                   "train", "test", "paper train", "paper test"]
         lines += ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
