@@ -16,6 +16,18 @@ import mjmaze
 from mjmaze import files, render, suite
 
 
+def frame_strip(frames: list[np.ndarray], scale: int = 2, gap: int = 4) -> np.ndarray:
+    """Frames side by side, each ``scale`` times larger, ``gap`` white pixels apart (the frames are dim)."""
+    big = [np.repeat(np.repeat(f, scale, axis=0), scale, axis=1) for f in frames]
+    height = big[0].shape[0]
+    strip = np.full((height, sum(f.shape[1] for f in big) + gap * (len(big) - 1), 3), 255, dtype=np.uint8)
+    x = 0
+    for f in big:
+        strip[:, x:x + f.shape[1]] = f
+        x += f.shape[1] + gap
+    return strip
+
+
 def rollout(scenario: str, steps: int, seed: int, strip_frames: int, **task_kwargs) -> dict:
     """Runs a uniformly random policy for ``steps`` agent steps."""
     env = mjmaze.load(scenario, task_kwargs={"random": seed, **task_kwargs})
@@ -68,7 +80,7 @@ def main(argv: list[str] | None = None) -> None:
 
     import imageio.v3 as iio  # only needed for the picture
 
-    strip = np.concatenate(result["frames"], axis=1)
+    strip = frame_strip(result["frames"])
     files.atomic_write_bytes(args.out, iio.imwrite("<bytes>", strip, extension=".png"))
     print(f"  frames            : {args.out} ({strip.shape[1]}x{strip.shape[0]})")
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import re
 import pathlib
 from collections.abc import Sequence
 
@@ -101,6 +102,21 @@ class TopDown:
                      width=width + 1)
         return np.asarray(canvas)
 
+    def legend(self) -> list[tuple[str, tuple[int, int, int]]]:
+        """``[(label, rgb)]`` of what :meth:`draw` puts on the map: the spawn, the path, the agent, and each
+        kind of object shown now, in its colour on the map (objects named ``item_3`` count as "item")."""
+        entries = [("spawn", SPAWN_COLOUR), ("path", PATH_COLOUR), ("agent", AGENT_COLOUR)]
+        model = self.physics.model.ptr
+        ids = self.physics.object_ids([obj.name for obj in self.task.objects])[1]
+        for obj, geom in zip(self.task.objects, ids):
+            if model.geom_group[geom] == render.HIDDEN_GROUP:
+                continue
+            label = re.sub(r"_?\d+$", "", obj.name).replace("_", " ")
+            entry = (label, tuple(int(round(255 * min(1.0, c))) for c in model.geom_rgba[geom][:3]))
+            if entry not in entries:
+                entries.append(entry)
+        return entries
+
     def _line(self, pen, poses, colour, width: int) -> None:
         poses = np.asarray(poses, dtype=float)
         if len(poses) >= 2:
@@ -169,6 +185,30 @@ def _font(size: int):
         return ImageFont.load_default()
 
 
+def with_legend(image: np.ndarray, entries: Sequence[tuple[str, tuple[int, int, int]]]) -> np.ndarray:
+    """``image`` (a map) above a key: a swatch and a label per entry (:meth:`TopDown.legend`), wrapped to its width."""
+    font_size, pad = 12, 6
+    swatch = font_size
+    font = _font(font_size)
+    measure = ImageDraw.Draw(Image.new("RGB", (1, 1)))
+    placed, x, row = [], pad, 0
+    for label, rgb in entries:
+        width = swatch + 4 + int(measure.textlength(label, font=font)) + 12
+        if x + width > image.shape[1] and x > pad:
+            x, row = pad, row + 1
+        placed.append((x, row, label, rgb))
+        x += width
+    key_height = (row + 1) * (font_size + pad) + pad
+    canvas = Image.new("RGB", (image.shape[1], image.shape[0] + key_height), BACKGROUND)
+    canvas.paste(Image.fromarray(image), (0, 0))
+    pen = ImageDraw.Draw(canvas)
+    for x, row, label, rgb in placed:
+        y = image.shape[0] + pad + row * (font_size + pad)
+        pen.rectangle((x, y, x + swatch, y + swatch), fill=tuple(rgb), outline=TEXT_COLOUR)
+        pen.text((x + swatch + 4, y - 1), label, fill=TEXT_COLOUR, font=font)
+    return np.asarray(canvas)
+
+
 def compose(ego: np.ndarray, top_down: np.ndarray, lines: Sequence[str] = (), scale: int = 4) -> np.ndarray:
     """One picture: ``lines`` of text above the ego frame scaled ``scale`` times and the map.
 
@@ -227,6 +267,7 @@ def main(argv: list[str] | None = None) -> None:
             break
         poses.append(env.physics.agent_pose())
     image = top_down.draw(spawn_map, path=np.array(poses), agent_pose=poses[-1] if args.random_steps else None)
+    image = with_legend(image, top_down.legend())
     top_down.close()
     env.task.close()
     save_png(args.out, image)

@@ -44,7 +44,23 @@ def test_video_falls_back_to_gif(tmp_path):
     out = tmp_path / "episode.gif"
     record.main(["random", "--scenario", "two_colour", "--episodes", "1", "--max-steps", "6", "--out", str(out)])
     frames = iio.imread(out, index=None)
-    assert frames.shape[0] == 7 and frames.std() > 10
+    # A GIF keeps every second frame at half size (a whole one made 20 MB for two K-item episodes).
+    assert frames.shape[0] == 4 and frames.std() > 10
+    assert json.loads(out.with_suffix(".json").read_text())["frames"] == 4
+    mp4 = tmp_path / "episode.mp4"
+    record.main(["random", "--scenario", "two_colour", "--episodes", "1", "--max-steps", "6", "--out", str(mp4)])
+    assert frames.shape[1:3] == tuple(-(-n // 2) for n in imageio.get_reader(mp4).get_data(0).shape[:2])
+
+
+def test_the_heatmap_scale_is_the_episodes_own():
+    # A trained agent's GRU units often stay within +-0.1: on a +-1 scale they were drawn blank.
+    from mjmaze.train import policy
+
+    hidden = np.random.default_rng(0).uniform(-0.09, 0.09, size=(40, 128)).astype(np.float32)
+    episode = policy.Episode(config_index=0, poses=np.zeros((41, 3)), actions=np.zeros(40, int), rewards=np.zeros(40),
+                             hidden=hidden, landmark_in_view=np.zeros(41, bool), infos=[])
+    image = analysis.heatmap(episode, "labyrinth", "test").axes[0].images[0]
+    assert image.get_clim() == pytest.approx((-0.0891, 0.0891), abs=2e-3)
 
 
 def test_video_of_a_trained_run_and_flags_that_contradict_it(tmp_path):

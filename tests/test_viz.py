@@ -95,8 +95,18 @@ def test_map_cli_writes_a_picture_with_a_path(tmp_path, capsys):
     viz.main(["--scenario", "two_colour", "--complexity", "5", "--config", "3", "--random-steps", "50",
               "--map-size", "128", "--out", str(out)])
     image = iio.imread(out)
-    assert image.shape == (128, 128, 3) and image.std() > 10
+    # The 128-pixel map, then its key below: spawn, path, agent, the totem and items in their colours.
+    assert image.shape[1] == 128 and image.shape[0] > 128 and image[:128].std() > 10
     assert "configuration 3" in capsys.readouterr().out
+
+
+def test_the_map_key_names_what_is_drawn_in_its_colours(labyrinth5):
+    _, top_down = labyrinth5
+    entries = dict(top_down.legend())
+    assert list(entries)[:3] == ["spawn", "path", "agent"] and entries["spawn"] == viz.SPAWN_COLOUR
+    assert "exit" in entries  # the scenario's object, in its map colour
+    keyed = viz.with_legend(top_down.draw(), top_down.legend())
+    assert keyed.shape[1] == 200 and keyed.shape[0] > 200  # wrapped to the map's width
 
 
 def test_compose_puts_text_above_the_scaled_view_and_the_map():

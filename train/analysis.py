@@ -71,7 +71,10 @@ def heatmap(episode: policy.Episode, scenario: str, title: str) -> Figure:
     """Activations of one episode over time, the landmark's first sighting marked."""
     figure = Figure(figsize=(10, 4))
     axes = figure.subplots()
-    image = axes.imshow(episode.hidden.T, aspect="auto", cmap="RdBu_r", vmin=-1, vmax=1, interpolation="nearest")
+    # A GRU unit lies in (-1, 1), but a trained agent's often stay within +-0.1: a +-1 scale drew them
+    # blank. The scale is the episode's own (99th percentile of |h|), symmetric so that white is 0.
+    scale = max(float(np.percentile(np.abs(episode.hidden), 99)), 1e-3)
+    image = axes.imshow(episode.hidden.T, aspect="auto", cmap="RdBu_r", vmin=-scale, vmax=scale, interpolation="nearest")
     seen = episode.landmark_first_seen
     if seen is not None and seen < episode.length:
         axes.axvline(seen, color="k", linestyle="--", linewidth=1.5,
@@ -80,7 +83,7 @@ def heatmap(episode: policy.Episode, scenario: str, title: str) -> Figure:
     axes.set_xlabel("step")
     axes.set_ylabel("hidden unit")
     axes.set_title(title, fontsize=10)
-    figure.colorbar(image, ax=axes, label="activation")
+    figure.colorbar(image, ax=axes, label=f"activation (colour scale +-{scale:.2g}, the episode's 99th percentile)")
     return figure
 
 
