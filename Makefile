@@ -24,7 +24,7 @@ TORCH_INDEX ?=
 # The main job (mjmaze.train.first_run): A2C on Labyrinth 5x5 in ~10 minutes on
 # 2 CPU cores, then a greedy evaluation beside a random policy, a learning
 # curve and a video. RUN_ARGS=--paper trains with the paper's configuration.
-RUN_STEPS ?= 800000
+RUN_STEPS ?= 1000000
 RUN_ARGS ?=
 
 .PHONY: run test bench setup system-deps test-deps clean

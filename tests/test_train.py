@@ -1,6 +1,7 @@
 """The A2C baseline: returns and losses by hand, a smoke run, checkpoints, resume, evaluation."""
 
 import json
+import pathlib
 import math
 import re
 
@@ -315,3 +316,19 @@ def test_workers_that_keep_dying_end_in_a_checkpoint_and_one_line(tmp_path, monk
     assert "failed 3 times in a row" in message and "--resume" in message and "\n" not in message
     saved = checkpoint.checkpoints(tmp_path / "tiny" / "checkpoints")
     assert checkpoint.load(saved[-1])["step"] == 4
+
+
+def test_the_main_job_trains_evaluates_beside_chance_draws_films_and_says_so(tmp_path, monkeypatch, capsys):
+    from mjmaze.train import first_run
+
+    monkeypatch.setattr(first_run, "QUICK", {"num_envs": 4, "num_steps": 8})
+    summary = first_run.main_job(total_steps=64, run_name="first", runs_dir=str(tmp_path), eval_configs=2,
+                                 eval_envs=2, video_steps=5)
+    run = tmp_path / "first"
+    assert json.loads((run / "config.json").read_text())["env_id"] == summary["env_id"] == "mjmaze/Labyrinth-v2"
+    assert (run / "eval.json").exists() and (run / "eval_random.json").exists()
+    assert (run / "curve.png").stat().st_size > 1000 and pathlib.Path(summary["video"]).stat().st_size > 1000
+    printed = capsys.readouterr().out.strip().splitlines()[-3:]
+    assert printed == summary["lines"]
+    assert printed[0].startswith("trained: A2C on mjmaze/Labyrinth-v2 size 5, 64 agent steps")
+    assert "a random policy: train" in printed[1] and str(run / "curve.png") in printed[2]
