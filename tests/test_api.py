@@ -139,7 +139,9 @@ def test_random_rollout_prints_metrics_and_writes_a_frame_strip(tmp_path, capsys
     printed = capsys.readouterr().out
     assert "obs/s" in printed and "two_colour" in printed
     strip = iio.imread(out)
-    assert strip.shape == (64, 4 * 112, 3) and strip.std() > 0
+    # Four frames at 2x, 4 white pixels apart (frames are dim: without gaps they ran together).
+    assert strip.shape == (128, 4 * 224 + 3 * 4, 3) and strip.std() > 0
+    assert (strip[:, 224:228] == 255).all() and not (strip[:, :224] == 255).all(axis=(0, 2)).any()
 
 
 def test_the_cpu_envs_import_neither_warp_nor_torch():
