@@ -27,13 +27,19 @@ TORCH_INDEX ?=
 RUN_STEPS ?= 1000000
 RUN_ARGS ?=
 
-.PHONY: run test bench setup system-deps test-deps clean
+.PHONY: run test test-fast bench setup system-deps test-deps clean
 
 run: system-deps $(VENV)/.stamp-torch $(VENV)/.stamp-train,viz
 	$(PY) -m mjmaze.train.first_run --total-steps $(RUN_STEPS) $(RUN_ARGS)
 
 test: system-deps test-deps $(VENV)/.stamp-torch $(VENV)/.stamp-triton $(VENV)/.stamp-train,dev
 	$(PY) -m pytest -q
+
+# The tests that take seconds, not minutes: no training, Warp, Ray or X display
+# (pytest markers in pyproject.toml). `make test` runs everything.
+FAST := not slow and not warp and not ray and not display
+test-fast: system-deps $(VENV)/.stamp-torch $(VENV)/.stamp-train,dev
+	$(PY) -m pytest -q -m "$(FAST)"
 
 bench: system-deps $(VENV)/.stamp-bench
 	$(PY) bench/speed.py

@@ -23,7 +23,7 @@ class MazeEnv(gym.Env):
     same mazes, spawns and frames.
     """
 
-    metadata = {"render_modes": ["rgb_array"], "render_fps": 35 / base.TICS_PER_STEP}
+    metadata = {"render_modes": ["rgb_array"], "render_fps": base.STEPS_PER_SECOND}
 
     def __init__(self, scenario: str, render_mode: str | None = None, **task_kwargs: Any):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:

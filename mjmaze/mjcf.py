@@ -38,7 +38,7 @@ class Room:
     They make mjmaze's frames show the mean colours of the released scenario's
     Doom textures as ViZDoom draws them at the released sector light (160):
     walls and floor are lit (:func:`_add_distance_falloff`), the ceiling is
-    seen in its colour as is. ``python docs/doom_frames.py --calibrate`` prints
+    seen in its colour as is. ``python tools/doom_frames.py --calibrate`` prints
     ViZDoom's colours beside mjmaze's (docs/look.md).
     """
 

@@ -25,7 +25,7 @@ import mjmaze
 from mjmaze import files, suite, viz
 from mjmaze.tasks import base
 
-STEPS_PER_SECOND = 35 / base.TICS_PER_STEP
+STEPS_PER_SECOND = base.STEPS_PER_SECOND
 KEY_LETTERS = "wasd"
 
 

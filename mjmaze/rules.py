@@ -98,6 +98,37 @@ def seed_key(random_state) -> int:
     return int(random_state.randint(1 << 32, dtype="int64"))
 
 
+def on_host(xp) -> bool:
+    """Whether ``xp``'s arrays are numpy's, whose values the host reads for free (torch's may be on a GPU)."""
+    return array_api_compat.is_numpy_namespace(xp)
+
+
+def loop_count(xp, counts: Array, most: int) -> int:
+    """How many rounds a loop over up to ``counts`` ``(B,)`` things per env needs: ``max(counts)`` on numpy, ``most`` on torch.
+
+    Reading the maximum back from a GPU makes the host wait for every queued
+    kernel; a fixed count keeps the step free of such waits (and compilable
+    whole, ``torch.compile(fullgraph=True)``). Rounds past an env's own count
+    must change nothing.
+    """
+    return int(xp.max(counts)) if on_host(xp) and counts.shape[0] else most
+
+
+_CONSTANTS: dict = {}
+
+
+def constant(xp, values: tuple, dtype, device) -> Array:
+    """``values`` (a module-level tuple) as an array on ``device``, made once per device and dtype.
+
+    A table built from host data at every step would be an upload at every step.
+    """
+    key = (id(values), xp.__name__, str(dtype), str(device))
+    table = _CONSTANTS.get(key)
+    if table is None:
+        table = _CONSTANTS[key] = xp.asarray(values, dtype=dtype, device=device)
+    return table
+
+
 def device(x: Array):
     """The device ``x`` lives on (``"cpu"`` for numpy)."""
     return array_api_compat.device(x)
@@ -130,9 +161,24 @@ DAMAGE_TO_ALPHA = (
 MAX_FLASH_ALPHA = 0.5  # ZDoom keeps at least half of the view
 
 
+def at_most(xp, x: Array, bound) -> Array:
+    """``min(x, bound)`` elementwise for a Python number ``bound``.
+
+    Not ``xp.minimum``: array_api_compat turns its scalar into a tensor through
+    ``torch.result_type``, which ``torch.compile`` cannot put in a graph; not
+    ``xp.clip``: numpy's costs several times more per call.
+    """
+    return xp.where(x > bound, bound, x)
+
+
+def at_least(xp, x: Array, bound) -> Array:
+    """``max(x, bound)`` elementwise for a Python number ``bound`` (see :func:`at_most`)."""
+    return xp.where(x < bound, bound, x)
+
+
 def count_down(xp, count: Array, tics) -> Array:
     """A flash counter ``tics`` tics later with nothing new: less one a tic, never below 0."""
-    return xp.maximum(count - tics, 0)  # not clip: numpy's clip costs several times more per call
+    return at_least(xp, count - tics, 0)
 
 
 def bonus_after_step(xp, bonus_count: Array, pickup_tic: Array, tics: int) -> Array:
@@ -147,11 +193,11 @@ def flash(xp, damage_count: Array, bonus_count: Array) -> tuple[Array, Array]:
     sum's opacity at :data:`MAX_FLASH_ALPHA`.
     """
     dev = device(damage_count)
-    table = xp.asarray(DAMAGE_TO_ALPHA, dtype=xp.float64, device=dev)
+    table = constant(xp, DAMAGE_TO_ALPHA, xp.float64, dev)
     red = table[xp.clip(damage_count, max=len(DAMAGE_TO_ALPHA) - 1)] / 255
     gold = xp.astype(xp.clip(bonus_count * 8, max=128), xp.float64) / 255
     alpha = gold + (1 - gold) * red
     gold_share = xp.where(alpha > 0, gold / xp.where(alpha > 0, alpha, 1.0), 0.0)
-    rgb = (gold_share[:, None] * xp.asarray(BONUS_RGB, dtype=xp.float64, device=dev)
-           + (1 - gold_share[:, None]) * xp.asarray(DAMAGE_RGB, dtype=xp.float64, device=dev))
+    rgb = (gold_share[:, None] * constant(xp, BONUS_RGB, xp.float64, dev)
+           + (1 - gold_share[:, None]) * constant(xp, DAMAGE_RGB, xp.float64, dev))
     return rgb, xp.clip(alpha, max=MAX_FLASH_ALPHA)

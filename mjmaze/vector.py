@@ -42,19 +42,16 @@ import types
 from multiprocessing import shared_memory
 from typing import Any
 
-import gymnasium as gym
 import numpy as np
 from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode
-from gymnasium.vector.utils import batch_space
 
-from mjmaze import registry, suite
+from mjmaze import batch, registry, suite
 from mjmaze.tasks import base
 
 SHARED_MEMORY_PREFIX = "mjmaze_"
 # How long a waiting process polls before it sleeps by default (see _poll_then_block).
 POLL_SECONDS = 0.002
-AUTORESET_MODES = {"next_step": AutoresetMode.NEXT_STEP, "same_step": AutoresetMode.SAME_STEP}
 
 
 class WorkerError(RuntimeError):
@@ -289,7 +286,7 @@ def _main_module_hidden(scenario: registry.Scenario):
         sys.modules["__main__"] = main
 
 
-class MazeVectorEnv(gym.vector.VectorEnv):
+class MazeVectorEnv(batch.BatchEnv):
     """``num_envs`` copies of one mjmaze scenario in ``num_workers`` processes.
 
     Args:
@@ -335,13 +332,12 @@ class MazeVectorEnv(gym.vector.VectorEnv):
         render_mode: str | None = None,
         **task_kwargs: Any,
     ):
-        if not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
-            raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
-        mode = autoreset_mode if isinstance(autoreset_mode, AutoresetMode) else AUTORESET_MODES.get(autoreset_mode)
-        if mode not in AUTORESET_MODES.values():
-            raise ValueError(f"autoreset_mode must be one of {tuple(AUTORESET_MODES)}, got {autoreset_mode!r}")
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
+        # Checks the arguments here, in this process, and tells shapes and info fields.
+        probe = suite.make_task(scenario, task_kwargs)
+        self._setup(num_envs, scenario, probe, autoreset_mode, render_modes=["rgb_array"])
+        self.render_mode = render_mode
         usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
         if num_workers is None:
             num_workers = usable - 1 if step_in_caller else usable
@@ -349,24 +345,8 @@ class MazeVectorEnv(gym.vector.VectorEnv):
         if num_workers < (0 if step_in_caller else 1):
             raise ValueError(f"num_workers must be >= {0 if step_in_caller else 1}, got {num_workers}")
 
-        # Checks the arguments here, in this process, and tells shapes and info fields.
-        probe = suite.make_task(scenario, task_kwargs)
-        frame_spec = probe.observation_spec(None)["pixels"]
-        num_actions = probe.action_spec(None).num_values
         num_configs = len(probe.configs)
-        info_fields = probe.info_fields()
         first = task_kwargs.pop("first_config", 0)
-
-        self.num_envs = int(num_envs)
-        self.scenario = scenario
-        self.render_mode = render_mode
-        self.autoreset_mode = mode
-        self.metadata = {"autoreset_mode": mode, "render_modes": ["rgb_array"], "render_fps": 35 / 4}
-        self.single_observation_space = gym.spaces.Box(0, 255, frame_spec.shape, np.uint8)
-        self.single_action_space = gym.spaces.Discrete(num_actions)
-        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
-        self.action_space = batch_space(self.single_action_space, self.num_envs)
-        self.closed = False
         self._copy = copy
         self._timeout = float(timeout)
         if poll_seconds is not None and not poll_seconds >= 0:
@@ -380,10 +360,9 @@ class MazeVectorEnv(gym.vector.VectorEnv):
 
         scalar_dtype = np.dtype(
             [("reward", np.float64), ("terminated", np.bool_), ("truncated", np.bool_)]
-            + [(name, np.dtype(kind)) for name, kind in info_fields.items()]
+            + [(name, np.dtype(kind)) for name, kind in self.info_fields.items()]
         )
-        self._info_fields = tuple(info_fields)
-        layout = _array_layout(self.num_envs, num_workers, frame_spec.shape, scalar_dtype, mode == AutoresetMode.SAME_STEP)
+        layout = _array_layout(self.num_envs, num_workers, self.single_observation_space.shape, scalar_dtype, self.same_step)
         self._shm = shared_memory.SharedMemory(
             name=SHARED_MEMORY_PREFIX + secrets.token_hex(8), create=True, size=_layout_size(layout)
         )
@@ -395,8 +374,8 @@ class MazeVectorEnv(gym.vector.VectorEnv):
         # The first shares (the larger ones) go to the workers; the last one is the caller's.
         shares = [ids.tolist() for ids in np.array_split(np.arange(self.num_envs), num_workers + step_in_caller)]
         self._worker_envs = shares[:num_workers]
-        offsets = [(first + i * num_configs // self.num_envs) % num_configs for i in range(self.num_envs)]
-        same_step = mode == AutoresetMode.SAME_STEP
+        offsets = batch.first_configs(first, self.num_envs, num_configs)
+        same_step = self.same_step
         self._conns, self._processes = [], []
         self._local: _EnvGroup | None = None
         declaration = registry.get(scenario)
@@ -435,15 +414,8 @@ class MazeVectorEnv(gym.vector.VectorEnv):
     # -- the gymnasium API ------------------------------------------------
 
     def reset(self, *, seed: int | list[int] | None = None, options: dict | None = None):
-        if seed is None:
-            seeds = None
-        elif isinstance(seed, (int, np.integer)):
-            seeds = [int(seed) + i for i in range(self.num_envs)]
-        else:
-            seeds = [int(s) for s in seed]
-            if len(seeds) != self.num_envs:
-                raise ValueError(f"reset needs one seed per env ({self.num_envs}), got {len(seeds)}")
-        if seed is not None:
+        seeds = batch.env_seeds(seed, self.num_envs)
+        if seeds is not None:
             self._np_random, self._np_random_seed = seeding.np_random(seeds[0])
         self._send_all("reset", seeds)
         self._run_local("reset", seeds)
@@ -464,11 +436,11 @@ class MazeVectorEnv(gym.vector.VectorEnv):
         self._steps_taken += 1
         scalars = self._scalars
         infos = self._infos()
-        if self.autoreset_mode == AutoresetMode.SAME_STEP:
+        if self.same_step:
             ended = np.flatnonzero(scalars["terminated"] | scalars["truncated"])
             final_scalars = self._arrays["final_scalars"]
             for i in ended:
-                final_info = {name: final_scalars[name][i].item() for name in self._info_fields}
+                final_info = {name: final_scalars[name][i].item() for name in self.info_fields}
                 infos = self._add_info(infos, {"final_obs": self._arrays["final_obs"][i].copy(), "final_info": final_info}, int(i))
         result = (
             self._observations(),
@@ -522,12 +494,8 @@ class MazeVectorEnv(gym.vector.VectorEnv):
         return self._arrays["obs"].copy() if self._copy else self._arrays["obs"]
 
     def _infos(self) -> dict:
-        infos = {}
-        everyone = np.ones(self.num_envs, dtype=bool)
-        for name in self._info_fields:
-            infos[name] = self._scalars[name].copy()
-            infos[f"_{name}"] = everyone.copy()
-        return infos
+        return self._batched_infos({name: self._scalars[name].copy() for name in self.info_fields},
+                                   np.ones(self.num_envs, dtype=bool))
 
     def _check_usable(self) -> None:
         if self._error is not None:

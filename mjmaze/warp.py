@@ -37,16 +37,14 @@ import math
 import xml.etree.ElementTree as ET
 from typing import Any
 
-import gymnasium as gym
 import mujoco
 import numpy as np
 import torch
 from gymnasium.vector import AutoresetMode
-from gymnasium.vector.utils import batch_space
 
 import mujoco_warp as mjw
 import warp as wp
-from mjmaze import mjcf, rules, suite
+from mjmaze import batch, mjcf, rules, suite
 from mjmaze.render import pistol_boxes, tint
 from mjmaze.tasks import base
 
@@ -120,7 +118,7 @@ def build_model(task: base.MazeTask) -> tuple[mujoco.MjModel, np.ndarray, np.nda
     return model, mesh_of_config, box_z
 
 
-class MazeBatchEnv(gym.vector.VectorEnv):
+class MazeBatchEnv(batch.BatchEnv):
     """``num_envs`` envs of a scenario in one MuJoCo Warp model on ``device``; see the module docstring.
 
     Args:
@@ -158,13 +156,6 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         render_segmentation: bool = False,
         **task_kwargs: Any,
     ):
-        if not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
-            raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
-        modes = {"next_step": AutoresetMode.NEXT_STEP, "same_step": AutoresetMode.SAME_STEP}
-        mode = autoreset_mode if isinstance(autoreset_mode, AutoresetMode) else modes.get(autoreset_mode)
-        if mode not in modes.values():
-            raise ValueError(f"autoreset_mode must be one of {tuple(modes)}, got {autoreset_mode!r}")
-        self.autoreset_mode = mode
         self._keep_final_obs = bool(keep_final_obs)
         if str(device).startswith("cuda") and not torch.cuda.is_available():
             raise RuntimeError("device='cuda' but torch sees no CUDA GPU; pass device='cpu' (slow) or install a CUDA torch")
@@ -173,19 +164,12 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         wp.init()
         first = int(task_kwargs.pop("first_config", 0))
         self.task = task = suite.make_task(scenario, task_kwargs)
-        self.scenario = scenario
-        self.num_envs = n = int(num_envs)
+        self._setup(num_envs, scenario, task, autoreset_mode, render_modes=[])
+        n = self.num_envs
         self.device = torch.device(device)
         self._wp_device = wp.get_device(str(device))
         self.xp = rules.namespace(torch.zeros(1))
         height, width = task.height, task.width
-        self.metadata = {"autoreset_mode": mode, "render_modes": [], "render_fps": 35 / 4}
-        self.render_mode = None
-        self.single_observation_space = gym.spaces.Box(0, 255, (height, width, 3), np.uint8)
-        self.single_action_space = gym.spaces.Discrete(len(task.actions))
-        self.observation_space = batch_space(self.single_observation_space, n)
-        self.action_space = batch_space(self.single_action_space, n)
-        self.closed = False
 
         mjm, mesh_of_config, box_z = build_model(task)
         self._host_model = mjm
@@ -195,7 +179,7 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         self._mesh_of_config = torch.as_tensor(mesh_of_config, device=dev)
         self._box_z = torch.as_tensor(box_z, device=dev)
         num_configs = len(task.configs)
-        self._first = torch.tensor([(first + i * num_configs // n) % num_configs for i in range(n)], device=dev)
+        self._first = torch.tensor(batch.first_configs(first, n, num_configs), device=dev)
 
         def geom(name: str) -> int:
             return mujoco.mj_name2id(mjm, mujoco.mjtObj.mjOBJ_GEOM, name)
@@ -252,48 +236,45 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         self._cols = torch.arange(width, device=dev)
         self._obs = torch.zeros((n, height, width, 3), dtype=torch.uint8, device=dev)
         self.state: dict[str, torch.Tensor] | None = None
-        self._info_fields = task.info_fields()
 
     # -- gymnasium API ------------------------------------------------------
 
     def reset(self, *, seed: int | list[int] | None = None, options: dict | None = None):
         """Starts a new episode in every env; returns ``(observations, infos)`` on the device."""
         n = self.num_envs
-        if seed is None:
-            keys = np.random.default_rng().integers(1 << 32, size=n)
-        else:
-            seeds = [int(seed) + i for i in range(n)] if isinstance(seed, (int, np.integer)) else [int(s) for s in seed]
-            if len(seeds) != n:
-                raise ValueError(f"reset needs one seed per env ({n}), got {len(seeds)}")
-            keys = np.array([rules.seed_key(np.random.RandomState(s)) for s in seeds])
+        seeds = batch.env_seeds(seed, n)
+        keys = np.random.default_rng().integers(1 << 32, size=n) if seeds is None else batch.seed_keys(seeds)
         self._seed_keys.copy_(torch.as_tensor(keys, dtype=torch.int64))
         self._episodes.zero_()
         with self._warp_stream():
-            self._start_episodes(torch.arange(n, device=self.device))
+            self._start_episodes(torch.ones(n, dtype=torch.bool, device=self.device))
             self._show_state()
         self._ended.zero_()
         return self._obs.clone(), self._infos()
 
     def step(self, actions):
-        """One agent step in every env: ``(observations, rewards, terminated, truncated, infos)``, torch tensors."""
+        """One agent step in every env: ``(observations, rewards, terminated, truncated, infos)``, torch tensors.
+
+        Nothing here reads a value back from the device: envs that start anew
+        are a mask over all envs, never a list of indices, so the host queues a
+        step's work without waiting for the last one to finish.
+        """
         xp, task = self.xp, self.task
         actions = torch.as_tensor(actions, device=self.device).long()
-        ended_before = self._ended.clone()
+        ended_before = self._ended
         with self._warp_stream():
             self._advance_physics(self._actions[actions, 0], self._actions[actions, 1])
             reward, terminated, truncated = task.step_state(xp, self.state, self._path)
-            if self.autoreset_mode == AutoresetMode.NEXT_STEP:
+            if self.same_step:
+                restart = terminated | truncated
+                final = self._final_infos(restart)
+            else:
                 # Envs that ended on the previous step start anew; this step's action is ignored.
                 reward = torch.where(ended_before, 0.0, reward)
                 terminated = terminated & ~ended_before
                 truncated = truncated & ~ended_before
-                restart = torch.nonzero(ended_before).flatten()
-                final = {}
-            else:
-                restart = torch.nonzero(terminated | truncated).flatten()
-                final = self._final_infos(terminated | truncated) if len(restart) else {}
-            if len(restart):
-                self._start_episodes(restart)
+                restart, final = ended_before, {}
+            self._start_episodes(restart)
             self._show_state()
         self._ended = terminated | truncated
         infos = self._infos()
@@ -301,7 +282,11 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         return self._obs.clone(), reward.float(), terminated, truncated, infos
 
     def _final_infos(self, ended: torch.Tensor) -> dict:
-        """``final_info`` (and ``final_obs``) of the envs that just ended, before they are reset."""
+        """``final_info`` (and ``final_obs``) of the envs that just ended, before they are reset.
+
+        Built on every step (the mask says which envs it is for): finding out
+        whether any env ended would wait for the device.
+        """
         final = {"final_info": self._infos(mask=ended), "_final_info": ended}
         if self._keep_final_obs:
             self._show_state()
@@ -336,33 +321,57 @@ class MazeBatchEnv(gym.vector.VectorEnv):
             self._path[:, tic] = qpos[:, :2]
         self._bob = base.walking_bob(self.xp, vx, vy, dt)
 
-    def _start_episodes(self, envs: torch.Tensor) -> None:
-        """New episodes in ``envs`` (indices): configuration, the scenario's start, the arena."""
+    def _start_episodes(self, restart: torch.Tensor) -> None:
+        """New episodes where ``restart`` ``(N,)`` is set: configuration, the scenario's start, the arena.
+
+        Every env's start is worked out and kept only where ``restart`` is set:
+        a fixed-size batch, so no count or index list comes back from the
+        device. Except where a scenario's start is costly
+        (:attr:`mjmaze.tasks.base.MazeTask.costly_start`: Two-colour draws 20
+        items against every wall), which is worked out for the restarting envs
+        alone, at the cost of one wait for the device to say which they are.
+        """
+        if self.task.costly_start and self.state is not None:
+            envs = torch.nonzero(restart).flatten()
+            if len(envs):
+                self._start_rows(envs, restart)
+            return
+        self._start_rows(slice(None), restart)
+
+    def _start_rows(self, envs, restart: torch.Tensor) -> None:
+        """:meth:`_start_episodes` worked out for ``envs`` (indices, or every env) and kept where ``restart`` is set."""
         xp, task = self.xp, self.task
         episodes = self._episodes[envs]
         keys = task.episode_keys(xp, self._seed_keys[envs], episodes)
         config_index = task.config_indices(xp, keys, episodes, first=self._first[envs])
-        self._episodes[envs] = episodes + 1
-        self._config_index[envs] = config_index
         start = task.start_state(xp, {name: value[config_index] for name, value in self._config_table.items()}, keys)
-        if self.state is None or len(envs) == self.num_envs:
+        if self.state is None:
             self.state = start
-        else:
-            for name, value in start.items():
-                self.state[name][envs] = value
-        pose = start["pose"]
-        self._qpos[envs, 0:3] = pose.float()
-        self._qvel[envs] = 0.0
-        self._turn_held[envs] = 0
-        self._bob[envs] = 0.0
-        self._warmstart[envs] = 0.0
-        # The maze: its wall boxes, its wall mesh.
-        geom_pos = self._geom_pos
-        rows = envs[:, None]
-        geom_pos[rows, self._box_ids[None, :], 2] = self._box_z[config_index]
-        self._geom_dataid[envs, self._wall_visual] = self._mesh_of_config[config_index].int()
+            return self._start_arena(start, config_index, restart)
+        # The start where ``restart`` is set, the current state elsewhere, over every env.
+        start = {name: _scatter_rows(self.state[name], envs, value) for name, value in start.items()}
+        config_index = _scatter_rows(self._config_index, envs, config_index)
+        self.state = {name: _where_rows(restart, value, self.state[name]) for name, value in start.items()}
+        self._start_arena(start, config_index, restart)
+
+    def _start_arena(self, start: dict, config_index: torch.Tensor, restart: torch.Tensor) -> None:
+        """Puts every env where ``restart`` is set at its start: agent, maze, object colours."""
+        self._episodes = self._episodes + restart.long()
+        self._config_index = torch.where(restart, config_index, self._config_index)
+        rows = restart[:, None]
+        self._qpos[:, 0:3] = torch.where(rows, start["pose"].float(), self._qpos[:, 0:3])
+        self._qvel.mul_(~rows)
+        self._warmstart.mul_(~rows)
+        self._turn_held = torch.where(restart, 0.0, self._turn_held)
+        self._bob = torch.where(restart, 0.0, self._bob)
+        # The maze: its wall boxes, its wall mesh (Warp reads these arrays in place).
+        box_z = self._geom_pos[:, self._box_ids, 2]
+        self._geom_pos[:, self._box_ids, 2] = torch.where(rows, self._box_z[config_index], box_z)
+        mesh = self._geom_dataid[:, self._wall_visual]
+        self._geom_dataid[:, self._wall_visual] = torch.where(restart, self._mesh_of_config[config_index].int(), mesh)
         if "object_rgba" in start:
-            self._geom_rgba[rows, self._object_ids[None, :]] = start["object_rgba"].float()
+            rgba = self._geom_rgba[:, self._object_ids]
+            self._geom_rgba[:, self._object_ids] = torch.where(rows[:, :, None], start["object_rgba"].float(), rgba)
 
     def _place_objects(self, state: dict) -> None:
         """Moves every world's objects where ``state`` says; hidden or non-blocking ones below the floor."""
@@ -424,19 +433,26 @@ class MazeBatchEnv(gym.vector.VectorEnv):
         """The info fields of every env (tensors ``(N,)``), each with its ``_field`` mask (``mask``, default all)."""
         task, state = self.task, self.state
         qpos = self._qpos.double()
-        fields = dict(task.episode_metrics(state))
-        fields.update(
-            x=qpos[:, 0], y=qpos[:, 1], yaw=qpos[:, 2] - math.tau * torch.round(qpos[:, 2] / math.tau),
-            step=state["steps"], episode_return=state["episode_return"], config_index=self._config_index.clone(),
-        )
+        yaw = qpos[:, 2] - math.tau * torch.round(qpos[:, 2] / math.tau)
+        fields = base.episode_info(task.episode_metrics(state), qpos[:, 0], qpos[:, 1], yaw, state["steps"],
+                                   state["episode_return"], self._config_index)
         if mask is None:
             mask = torch.ones(self.num_envs, dtype=torch.bool, device=self.device)
-        infos = {}
-        for name in self._info_fields:
-            infos[name] = fields[name].clone()
-            infos[f"_{name}"] = mask
-        return infos
+        return self._batched_infos({name: fields[name].clone() for name in self.info_fields}, mask)
 
     def __repr__(self) -> str:
         return f"MazeBatchEnv({self.scenario!r}, num_envs={self.num_envs}, device={str(self.device)!r})"
 
+
+def _where_rows(rows: torch.Tensor, new: torch.Tensor, old: torch.Tensor) -> torch.Tensor:
+    """``new`` in the envs (first axis) where ``rows`` is set, ``old`` elsewhere."""
+    return torch.where(rows.view(-1, *([1] * (new.dim() - 1))), new, old)
+
+
+def _scatter_rows(full: torch.Tensor, envs, rows: torch.Tensor) -> torch.Tensor:
+    """``rows`` of envs ``envs`` written into a copy of ``full`` (all of it for ``envs = slice(None)``)."""
+    if isinstance(envs, slice):
+        return rows
+    full = full.clone()
+    full[envs] = rows
+    return full

@@ -2,7 +2,7 @@
 
 Each scenario is played beside a twin with ``flashes=False`` (same seed, same
 moves): the frames must differ by exactly the tint, and only where Doom flashes.
-Counts and opacities are ViZDoom's (docs/look.md, ``python docs/doom_frames.py --flashes``).
+Counts and opacities are ViZDoom's (docs/look.md, ``python tools/doom_frames.py --flashes``).
 """
 
 from __future__ import annotations

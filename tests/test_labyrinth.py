@@ -45,7 +45,7 @@ def test_time_limit_is_525_agent_steps_and_truncates(labyrinth9):
 
 
 # ViZDoom's own motion, frame skip 4, in its open health_gathering room
-# (`python bench/doom_motion.py`, docs/motion.md): map units (1/128 m) moved and
+# (`python tools/doom_motion.py`, docs/motion.md): map units (1/128 m) moved and
 # degrees turned per agent step.
 DOOM_FORWARD_FROM_REST = [7.1, 15.6, 21.4, 25.3, 27.9, 29.7, 30.9, 31.7, 32.2, 32.6, 32.8, 33.0]
 DOOM_COASTING = [26.0, 17.5, 11.8, 8.0, 5.4, 3.6]  # keys off forward (here: turning)

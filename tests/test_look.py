@@ -1,6 +1,6 @@
 """The frames look as ViZDoom draws the released maps (docs/look.md).
 
-The expected colours were measured in ViZDoom with ``python docs/doom_frames.py
+The expected colours were measured in ViZDoom with ``python tools/doom_frames.py
 --calibrate`` (same map, same pose, 112x64 after the released area resize);
 these tests hold them, so they run without ViZDoom.
 """

@@ -62,7 +62,7 @@ def test_the_released_weights_are_mjmaze_agents_layer_for_layer(released):
 
 def test_the_released_labyrinth_agent_solves_released_mazes_and_an_untrained_one_does_not(released, tmp_path):
     # The first 16 test mazes of Labyrinth 7, each played twice, greedily. The
-    # released agent solves 98% of the 64 in ViZDoom (bench/paper_agents_vizdoom.py);
+    # released agent solves 98% of the 64 in ViZDoom (tools/paper_agents_vizdoom.py);
     # in mjmaze too, or what it sees or how it moves has drifted from ViZDoom.
     result = evaluate.evaluate("paper:labyrinth_7", num_envs=16, num_configs=16, out=tmp_path / "eval.json",
                                progress=False)

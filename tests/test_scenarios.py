@@ -208,7 +208,7 @@ def test_pool_covers_a_full_episode():
 
 
 def test_the_floor_takes_8_health_every_32_tics_and_reaching_zero_ends_the_episode():
-    # As ViZDoom plays the released maze (python docs/doom_frames.py --flashes):
+    # As ViZDoom plays the released maze (python tools/doom_frames.py --flashes):
     # 92 at the first frame, 84 from tic 23, 76 from tic 55, ...
     env = load("two_colour", complexity=5)
     assert env.task.health == 92

@@ -61,6 +61,8 @@ def _sweep_command(tmp_path):
     ]
 
 
+@pytest.mark.ray
+@pytest.mark.slow
 def test_a_tiny_grid_survives_a_kill_resumes_without_redoing_and_reports(tmp_path):
     first, second = tmp_path / "tiny" / "two_colour_complexity1_s0", tmp_path / "tiny" / "two_colour_complexity1_s1"
     # 1. Start the grid (runs one at a time on 2 CPUs) and kill everything once the first run has
@@ -117,6 +119,7 @@ def test_flags_that_would_fail_after_training_fail_before_it(tmp_path, monkeypat
     assert not any(tmp_path.iterdir())  # nothing written: not even sweep.json
 
 
+@pytest.mark.ray
 def test_a_run_asking_for_a_gpu_ray_lacks_is_one_clear_error(tmp_path):
     with pytest.raises(SystemExit, match="--gpus-per-run 64.0 is more than the"):
         sweep.main(["--grid", "small", "--num-cpus", "2", "--gpus-per-run", "64", "--sweeps-dir", str(tmp_path)])

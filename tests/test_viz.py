@@ -198,6 +198,8 @@ def x_display():
     server.wait(timeout=10)
 
 
+@pytest.mark.display
+@pytest.mark.slow
 def test_the_play_window_under_a_real_x_display_takes_keys(tmp_path, x_display):
     import subprocess
     import sys

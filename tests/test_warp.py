@@ -6,6 +6,7 @@ Run on Warp's CPU device (no GPU needed): a first run compiles Warp's kernels
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 
@@ -18,6 +19,7 @@ import mjmaze
 from mjmaze import mjcf, registry, render, rules, suite
 from mjmaze.tasks import base
 
+pytestmark = [pytest.mark.warp, pytest.mark.slow]
 torch = pytest.importorskip("torch")
 pytest.importorskip("mujoco_warp")
 from mjmaze import warp as mjwarp  # noqa: E402
@@ -195,6 +197,38 @@ def test_next_step_autoreset_ignores_the_action_after_the_end():
     _, reward, terminated, truncated, info = batch.step(torch.tensor([2, 2]))
     assert float(reward[1]) == 0.0 and not terminated[1] and not truncated[1]
     assert int(info["step"][1]) == 0 and int(info["step"][0]) == 2
+
+
+@contextlib.contextmanager
+def _no_reads_from_the_device(monkeypatch):
+    """Fails on anything that makes the host wait for a GPU's results: a tensor's value read back in Python,
+    ``nonzero`` (its size is the data's), a Python loop or branch over a tensor."""
+    def refuse(*args, **kwargs):
+        raise AssertionError("a value was read back from the device")
+
+    with monkeypatch.context() as patch:
+        for name in ("__bool__", "__int__", "__float__", "__index__", "item", "tolist", "nonzero"):
+            patch.setattr(torch.Tensor, name, refuse)
+        patch.setattr(torch, "nonzero", refuse)
+        yield
+
+
+@pytest.mark.parametrize("scenario", [name for name in SETTINGS if not registry.get(name).task.costly_start])
+@pytest.mark.parametrize("mode", ["next_step", "same_step"])
+def test_a_step_never_waits_for_the_device(scenario, mode, monkeypatch):
+    batch = mjwarp.MazeBatchEnv(3, scenario, device="cpu", autoreset_mode=mode, **SETTINGS[scenario])
+    batch.reset(seed=SEED)
+    actions = torch.tensor([2, 0, 1])
+    ends = 0
+    for step in range(6):
+        if step % 2 == 0:  # env 0's episode runs out of time on this step: it restarts
+            batch.state["steps"][0] = base.EPISODE_STEPS - 1
+        with _no_reads_from_the_device(monkeypatch):
+            _, _, terminated, truncated, _ = batch.step(actions)
+        ends += int((terminated | truncated).sum())
+    assert ends >= 2
+    with pytest.raises(AssertionError, match="read back"), _no_reads_from_the_device(monkeypatch):
+        bool(terminated.any())  # the guard does catch a read
 
 
 def test_reached_through_gymnasium_by_one_word():

@@ -2,7 +2,7 @@
 
     python -m mjmaze.train.paper_table                                    # all 16 settings (~15 min on 2 cores)
     python -m mjmaze.train.paper_table --only labyrinth_9 two_colour_1
-    python -m mjmaze.train.paper_table --vizdoom runs/paper/vizdoom.json  # + bench/paper_agents_vizdoom.py's column
+    python -m mjmaze.train.paper_table --vizdoom runs/paper/vizdoom.json  # + tools/paper_agents_vizdoom.py's column
 
 Each released agent (``mjmaze.train.paper_agents``) plays its setting's released
 mazes in mjmaze, greedily, as ``mjmaze.train.evaluate`` plays a run (the first
@@ -121,7 +121,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--only", nargs="+", default=None, metavar="SETTING",
                         help=f"settings to play (default: all 16: {' '.join(paper_agents.AGENTS)})")
     parser.add_argument("--vizdoom", type=pathlib.Path, default=None,
-                        help="the same agents in ViZDoom (bench/paper_agents_vizdoom.py's output)")
+                        help="the same agents in ViZDoom (tools/paper_agents_vizdoom.py's output)")
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("runs/paper/table"),
                         help="writes <out>.md and <out>.json")
     parser.add_argument("--num-envs", type=int, default=16, help="parallel envs (must divide 64)")

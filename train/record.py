@@ -23,11 +23,12 @@ from tqdm import tqdm
 
 import mjmaze
 from mjmaze import files, suite, viz
+from mjmaze.tasks import base
 
 from . import checkpoint, policy
 from .settings import using_torch_threads
 
-FPS = 35 / 4  # real time: one frame per agent step (4 tics at 35 Hz)
+FPS = base.STEPS_PER_SECOND  # real time: one frame per agent step
 MAP_SIZE = 256
 
 

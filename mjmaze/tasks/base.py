@@ -29,8 +29,10 @@ from dm_env import specs
 from mjmaze import configs, mjcf, render, rules
 from mjmaze import layouts as layout_files
 
-# Timing: one physics step is one Doom tic; the agent acts every 4 tics.
+# Timing: one physics step is one Doom tic (35 a second); the agent acts every 4 tics.
+TICS_PER_SECOND = 35
 TICS_PER_STEP = 4
+STEPS_PER_SECOND = TICS_PER_SECOND / TICS_PER_STEP  # real time: 8.75 observations a second
 EPISODE_STEPS = 525  # 2100 tics
 # Motion: Doom's player movement, tic by tic (ZDoom's P_MovePlayer and
 # P_XYMovement; measured in ViZDoom, see docs/motion.md). A held forward key
@@ -197,6 +199,9 @@ class MazeTask(base.Task):
     #: ``render_weapon = true``, but every released map's ENTER script calls ``ClearInventory()``:
     #: ViZDoom drew no weapon in any of the paper's scenarios, so none does here (the ``-v0`` ids drew one).
     pistol: bool = False
+    #: Whether :meth:`start` costs much more than a step's rules for a batch: a batch backend then
+    #: starts only the envs that need it, rather than every env under a mask (:mod:`mjmaze.warp`).
+    costly_start: bool = False
 
     def __init__(
         self,
@@ -523,20 +528,15 @@ class MazeTask(base.Task):
 
     def info_fields(self) -> dict[str, type]:
         """Names and Python types of the fields of :meth:`get_info`, known before any episode."""
-        fields = {key: type(value) for key, value in self.metrics().items()}
-        fields.update(x=float, y=float, yaw=float, step=int, episode_return=float, config_index=int)
-        return fields
+        return {key: type(value) for key, value in episode_info(self.metrics(), 0.0, 0.0, 0.0, 0, 0.0, 0).items()}
 
     def get_info(self, physics: MazePhysics) -> dict:
         """Metric fields, the agent's pose and where the episode stands."""
-        x, y, yaw = physics.agent_pose()
-        info = self.metrics()
-        info.update(
-            x=x, y=y, yaw=yaw, step=self.steps,
-            episode_return=float(self.state["episode_return"][self.row]) if self.state is not None else 0.0,
-            config_index=self.config.index if self.config else -1,
+        return episode_info(
+            self.metrics(), *physics.agent_pose(), self.steps,
+            float(self.state["episode_return"][self.row]) if self.state is not None else 0.0,
+            self.config.index if self.config else -1,
         )
-        return info
 
     def close(self) -> None:
         """Frees the renderer's GL resources."""
@@ -566,7 +566,7 @@ def tic_motion(xp, vx, vy, yaw, forward, turn, turn_held, timestep: float):
 def walking_bob(xp, vx, vy, timestep: float):
     """Doom's bob in map units of a tic whose velocity after its thrust is ``(vx, vy)`` (m/s)."""
     speed_sq = (vx * vx + vy * vy) * (timestep / MAP_UNIT) ** 2  # (map units per tic)^2
-    return xp.minimum(speed_sq / 4, MAX_BOB)
+    return rules.at_most(xp, speed_sq / 4, MAX_BOB)
 
 
 def view_bob(xp, bob, tics):
@@ -581,6 +581,15 @@ def view_bob(xp, bob, tics):
     pistol_dx = bob * xp.cos(angle) * PISTOL_BOB_PIXELS[0]
     pistol_dy = bob * abs(xp.sin(angle)) * PISTOL_BOB_PIXELS[1]
     return eye_dz, pistol_dx, pistol_dy
+
+
+def episode_info(metrics: dict, x, y, yaw, step, episode_return, config_index) -> dict:
+    """An env's ``info`` (Python scalars) or a batch's (``(B,)`` arrays): the scenario's metric
+    fields, the agent's pose (yaw in ``(-pi, pi]``), the agent steps taken, the return so far
+    and the configuration played. The one list of fields every env and vector env reports.
+    """
+    return {**metrics, "x": x, "y": y, "yaw": yaw, "step": step, "episode_return": episode_return,
+            "config_index": config_index}
 
 
 def make_environment(task: MazeTask, environment_kwargs: dict | None = None) -> control.Environment:

@@ -61,7 +61,7 @@ ITEM_HEALTH = 25
 # Thing_Damage and clears the inventory: the armour just picked up absorbs
 # its share (ZDoom: int(damage x SavePercent)), so a wrong green item costs
 # 17 and a wrong red one 13, while a right one gives 25 (measured in ViZDoom:
-# python docs/doom_frames.py --two-colour RELEASED_WAD).
+# python tools/doom_frames.py --two-colour RELEASED_WAD).
 GREEN_ARMOUR_SAVES = 0.33335  # Doom's GreenArmor SavePercent
 RED_ARMOUR_SAVES = 0.5  # BlueArmor's, the armour Freedoom draws red
 WRONG_GREEN_DAMAGE = ITEM_HEALTH - int(ITEM_HEALTH * GREEN_ARMOUR_SAVES)
@@ -69,7 +69,7 @@ WRONG_RED_DAMAGE = ITEM_HEALTH - int(ITEM_HEALTH * RED_ARMOUR_SAVES)
 # The released maze's floor is ZDoom's Damage_LavaHefty (sector special 83): 8
 # health when the level's time is a multiple of 32 tics. ViZDoom's first
 # observation is 9 tics into the level, so the first hit has landed (health
-# 92) and the next comes 23 tics in (measured: python docs/doom_frames.py --flashes).
+# 92) and the next comes 23 tics in (measured: python tools/doom_frames.py --flashes).
 LAVA_DAMAGE = 8
 LAVA_EVERY_TICS = 32
 LAVA_FIRST_TIC = 23
@@ -102,6 +102,8 @@ TOTEM_RADIUS = TOTEM.size[0]
 # The agent's centre never comes closer to the totem's than this.
 TOTEM_CLEARANCE = TOTEM_RADIUS + base.AGENT_RADIUS
 ITEMS = tuple(mjcf.floor_thing(f"item_{k}", "cylinder", 31, 17, ITEM_RED) for k in range(POOL_SIZE))
+TOTEM_COLOURS = (tuple(RED), tuple(GREEN))  # by totem_green
+ITEM_COLOURS = tuple(tuple(ITEM_GREEN if k % 2 == 0 else ITEM_RED) for k in range(POOL_SIZE))
 
 
 class TwoColour(base.MazeTask):
@@ -110,6 +112,8 @@ class TwoColour(base.MazeTask):
     scenario = "two_colour"
     room = mjcf.SLIME_ROOM
     objects = (TOTEM, *ITEMS)
+    # 20 items, each tried at 32 points against every wall box: ~20x a step's spawn.
+    costly_start = True
 
     def __init__(
         self,
@@ -145,12 +149,9 @@ class TwoColour(base.MazeTask):
         totem_xy = config["object_xy"][:, 0]
         spawn_xy = config["spawn_xy"]
         totem_green = rules.uniform(xp, keys, rules.DRAW_COLOUR) < 0.5
-        rgba = xp.asarray(np.array([RED, GREEN]), device=device)
-        item_colours = xp.asarray(np.array([ITEM_RED, ITEM_GREEN]), device=device)
+        rgba = rules.constant(xp, TOTEM_COLOURS, xp.float64, device)
         # Items alternate colours, green first; the totem's is drawn per episode.
-        item_rgba = xp.broadcast_to(
-            item_colours[xp.asarray(1 - np.arange(POOL_SIZE) % 2, device=device)], (batch, POOL_SIZE, 4)
-        )
+        item_rgba = xp.broadcast_to(rules.constant(xp, ITEM_COLOURS, xp.float64, device)[None], (batch, POOL_SIZE, 4))
         inside_totem = xp.sum((spawn_xy - totem_xy) ** 2, axis=1) < TOTEM_CLEARANCE**2
         state = {
             "pose": xp.concat([spawn_xy, xp.zeros((batch, 1), dtype=xp.float64, device=device)], axis=1),
@@ -198,14 +199,14 @@ class TwoColour(base.MazeTask):
         damage, settled = state["damage_count"], xp.full(health.shape, -1, dtype=xp.int64, device=device)
         # A wrong item is the colour the totem is not.
         wrong_damage = xp.where(totem_green, WRONG_RED_DAMAGE, WRONG_GREEN_DAMAGE)
-        for rank in range(int(xp.max(num_events))):
+        for rank in range(rules.loop_count(xp, num_events, 1 + POOL_SIZE)):
             event = order[:, rank]
             tic = xp.take_along_axis(event_tic, event[:, None], axis=1)[:, 0]
             happens = (rank < num_events) & (health > 0)  # nothing reaches a dead agent
             lava = happens & (event == 0)
             correct = happens & (event > 0) & ((event % 2 == 1) == totem_green)  # even items (odd events) are green
             wrong = happens & (event > 0) & ~correct
-            raised = xp.minimum(health + ITEM_HEALTH, MAX_HEALTH)
+            raised = rules.at_most(xp, health + ITEM_HEALTH, MAX_HEALTH)
             reward = reward + self._correct_item_reward * xp.astype(correct & (raised > health), xp.float64)
             hurt = lava | wrong
             hit = xp.where(lava, LAVA_DAMAGE, xp.where(wrong, wrong_damage, 0))
@@ -213,7 +214,7 @@ class TwoColour(base.MazeTask):
             # Lava hurts before the tic's count-down, an item's damage after it.
             before_count = xp.astype(lava, xp.int64)
             counted = rules.count_down(xp, damage, tic - settled - before_count)
-            damage = xp.where(hurt, xp.minimum(counted + hit, rules.MAX_DAMAGE_COUNT) - before_count, damage)
+            damage = xp.where(hurt, rules.at_most(xp, counted + hit, rules.MAX_DAMAGE_COUNT) - before_count, damage)
             settled = xp.where(hurt, tic, settled)
         state["damage_count"] = rules.count_down(xp, damage, tics - 1 - settled)
         state["bonus_count"] = rules.bonus_after_step(xp, state["bonus_count"], xp.max(first_tic, axis=1), tics)
@@ -226,9 +227,11 @@ class TwoColour(base.MazeTask):
         collides = state["object_collides"]
         state["object_collides"] = xp.concat([collides[:, :1] | (clear & ~dead)[:, None], collides[:, 1:]], axis=1)
         # One item every 30 tics (never more than one per 4-tic step after the start).
-        due = xp.minimum(2 * START_ITEMS_PER_COLOUR + state["steps"] * base.TICS_PER_STEP // SPAWN_EVERY_TICS, self._item_cap)
+        due = rules.at_most(xp, 2 * START_ITEMS_PER_COLOUR + state["steps"] * base.TICS_PER_STEP // SPAWN_EVERY_TICS, self._item_cap)
         spawn = ~dead & (state["items_spawned"] < due)
-        if bool(xp.any(spawn)):
+        # On numpy most steps spawn nothing: skip the draws then. On torch, draw
+        # for every env and keep the spawns (asking whether any is due would wait for the GPU).
+        if not rules.on_host(xp) or bool(xp.any(spawn)):
             item = state["items_spawned"]
             xy, drawn = self._free_positions(xp, state, state["key"], item[:, None], agent_xy)
             slot = rules.one_hot(xp, item + 1, 1 + POOL_SIZE) & (spawn & drawn[:, 0])[:, None]

@@ -1,4 +1,4 @@
-"""Writes the README's frame per scenario: ``python docs/frames.py`` -> docs/<scenario>.png.
+"""Writes the README's frame per scenario: ``python tools/frames.py`` -> docs/<scenario>.png.
 
 Each frame is the agent's 64x112 view (shown at 2x) from a spot of the first
 training configuration where the scenario's objects are in sight.
@@ -44,7 +44,7 @@ def best_view(name: str, task_kwargs: dict) -> np.ndarray:
 
 
 def main() -> None:
-    out = pathlib.Path(__file__).parent
+    out = pathlib.Path(__file__).resolve().parent.parent / "docs"
     for name, kwargs in SCENES.items():
         frame = best_view(name, kwargs)
         iio.imwrite(out / f"{name}.png", frame.repeat(2, axis=0).repeat(2, axis=1))

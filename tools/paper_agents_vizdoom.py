@@ -1,7 +1,7 @@
 """The paper's agents in ViZDoom, as released: the other side of ``python -m mjmaze.train.paper_table``.
 
-    python bench/paper_agents_vizdoom.py RELEASED_CHECKOUT [--only labyrinth_9 two_colour_1] [--out FILE]
-    python bench/paper_agents_vizdoom.py RELEASED_CHECKOUT --agreement labyrinth_7   # the same action at the same pose?
+    python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT [--only labyrinth_9 two_colour_1] [--out FILE]
+    python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --agreement labyrinth_7   # the same action at the same pose?
 
 RELEASED_CHECKOUT is a checkout of github.com/edbeeching/3d_control_deep_rl
 (its ``3dcdrl/scenarios/custom_scenarios/`` holds each maze's ``.cfg``/``.wad``,

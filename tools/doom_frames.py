@@ -1,10 +1,10 @@
 """What the agent sees in ViZDoom and in mjmaze, same map, same pose.
 
-    python docs/doom_frames.py              # docs/doom_vs_mjmaze.png: the Labyrinth exit from 1-3 cells
-    python docs/doom_frames.py --calibrate  # colours of walls, floor, ceiling and objects, both engines
-    python docs/doom_frames.py --flashes    # ViZDoom's red (hurt) and gold (pickup) flashes, tic by tic
-    python docs/doom_frames.py --contrast   # how much Two-colour's items stand out, 1-4 m ahead
-    python docs/doom_frames.py --two-colour RELEASED_REPO/scenarios/basefiles/two_color_basefile.wad
+    python tools/doom_frames.py              # docs/doom_vs_mjmaze.png: the Labyrinth exit from 1-3 cells
+    python tools/doom_frames.py --calibrate  # colours of walls, floor, ceiling and objects, both engines
+    python tools/doom_frames.py --flashes    # ViZDoom's red (hurt) and gold (pickup) flashes, tic by tic
+    python tools/doom_frames.py --contrast   # how much Two-colour's items stand out, 1-4 m ahead
+    python tools/doom_frames.py --two-colour RELEASED_REPO/scenarios/basefiles/two_color_basefile.wad
                                             # the released Two-colour script played: health changes, tics survived
 
 Needs ViZDoom (``pip install -e ".[bench]"``; it draws Freedoom's textures and
@@ -246,7 +246,7 @@ def exit_figure() -> None:
     env.task.close()
     gap = np.full((4, rows[0].shape[1], 3), 255, np.uint8)
     image = np.concatenate([part for row in rows for part in (row, gap)][:-1])
-    out = pathlib.Path(__file__).parent / "doom_vs_mjmaze.png"
+    out = pathlib.Path(__file__).resolve().parent.parent / "docs" / "doom_vs_mjmaze.png"
     iio.imwrite(out, image.repeat(2, axis=0).repeat(2, axis=1))
     print(out)
 

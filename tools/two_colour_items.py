@@ -1,7 +1,7 @@
 """Right and wrong items a Two-colour run's policy picks up per episode.
 
-    python docs/two_colour_items.py RUN CHECKPOINT {greedy,sample,uniform} EPISODES
-    python docs/two_colour_items.py scripted {any,right} EPISODES [COMPLEXITY]
+    python tools/two_colour_items.py RUN CHECKPOINT {greedy,sample,uniform} EPISODES
+    python tools/two_colour_items.py scripted {any,right} EPISODES [COMPLEXITY]
 
 Plays test mazes (env seed 1) in one dm_control env and counts the items that
 leave the floor, by colour against the totem's: whether the policy tells them apart.

@@ -1,6 +1,6 @@
 """The agent's motion per agent step, ViZDoom beside mjmaze, in open space.
 
-    python bench/doom_motion.py          # needs ViZDoom: pip install -e ".[bench]"
+    python tools/doom_motion.py          # needs ViZDoom: pip install -e ".[bench]"
 
 Plays the same key sequences (frame skip 4) in ViZDoom's open `health_gathering`
 room and in an empty mjmaze arena (Two-colour at complexity 0) and prints, per

@@ -1,0 +1,105 @@
+"""What the two batch simulators share: the CPU worker processes and MuJoCo Warp.
+
+:class:`mjmaze.vector.MazeVectorEnv` (numpy, one MuJoCo model per env in
+worker processes) and :class:`mjmaze.warp.MazeBatchEnv` (torch, every env in
+one MuJoCo Warp model) are both :class:`BatchEnv`: the same arguments are
+checked the same way, env ``i`` is seeded and starts in the maze list the same
+way, the spaces, the metadata and the ``info`` fields are the same. Each
+simulator then only says how it steps, draws and resets its envs.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium.vector import AutoresetMode
+from gymnasium.vector.utils import batch_space
+
+from mjmaze import rules
+from mjmaze.tasks import base
+
+AUTORESET_MODES = {"next_step": AutoresetMode.NEXT_STEP, "same_step": AutoresetMode.SAME_STEP}
+
+
+def parse_autoreset_mode(value: str | AutoresetMode) -> AutoresetMode:
+    """``"next_step"`` or ``"same_step"`` (or the gymnasium enum) as the enum; anything else raises."""
+    mode = value if isinstance(value, AutoresetMode) else AUTORESET_MODES.get(value)
+    if mode not in AUTORESET_MODES.values():
+        raise ValueError(f"autoreset_mode must be one of {tuple(AUTORESET_MODES)}, got {value!r}")
+    return mode
+
+
+def env_seeds(seed: int | Sequence[int] | None, num_envs: int) -> list[int] | None:
+    """Each env's seed for ``reset(seed=...)``: ``s`` gives env ``i`` the seed ``s + i``, a list one each."""
+    if seed is None:
+        return None
+    if isinstance(seed, (int, np.integer)):
+        return [int(seed) + i for i in range(num_envs)]
+    seeds = [int(s) for s in seed]
+    if len(seeds) != num_envs:
+        raise ValueError(f"reset needs one seed per env ({num_envs}), got {len(seeds)}")
+    return seeds
+
+
+def seed_keys(seeds: Sequence[int]) -> np.ndarray:
+    """``(N,)`` int64: the rules' key of an env seeded with each seed, as a single env's ``reset(seed=s)`` draws it."""
+    return np.array([rules.seed_key(np.random.RandomState(s)) for s in seeds], dtype=np.int64)
+
+
+def first_configs(first: int, num_envs: int, num_configs: int) -> list[int]:
+    """Where each env starts cycling through the configurations: spread evenly from ``first``.
+
+    So a batch covers different mazes at once rather than every env playing configuration ``first``.
+    """
+    return [(int(first) + i * num_configs // num_envs) % num_configs for i in range(num_envs)]
+
+
+class BatchEnv(gym.vector.VectorEnv):
+    """Base of mjmaze's vector envs: the arguments, spaces and metadata both simulators share.
+
+    A subclass calls :meth:`_setup` first in its ``__init__``, then builds its
+    simulator; see the module docstring.
+    """
+
+    render_mode: str | None = None
+
+    def _setup(
+        self,
+        num_envs: int,
+        scenario: str,
+        task: base.MazeTask,
+        autoreset_mode: str | AutoresetMode,
+        render_modes: Sequence[str],
+    ) -> None:
+        """Checks ``num_envs`` and ``autoreset_mode`` and sets the spaces and metadata of ``task``'s envs."""
+        if not isinstance(num_envs, (int, np.integer)) or isinstance(num_envs, bool) or num_envs < 1:
+            raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
+        mode = parse_autoreset_mode(autoreset_mode)
+        self.num_envs = int(num_envs)
+        self.scenario = scenario
+        self.autoreset_mode = mode
+        self.metadata = {"autoreset_mode": mode, "render_modes": list(render_modes), "render_fps": base.STEPS_PER_SECOND}
+        self.single_observation_space = gym.spaces.Box(0, 255, (task.height, task.width, 3), np.uint8)
+        self.single_action_space = gym.spaces.Discrete(len(task.actions))
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        #: The names and Python types of the ``info`` fields, in order (:meth:`mjmaze.tasks.base.MazeTask.info_fields`).
+        self.info_fields: dict[str, type] = task.info_fields()
+        self.closed = False
+
+    @property
+    def same_step(self) -> bool:
+        """Whether an env that ends is reset in the same step (``autoreset_mode="same_step"``)."""
+        return self.autoreset_mode == AutoresetMode.SAME_STEP
+
+    def _batched_infos(self, columns: dict[str, Any], mask) -> dict:
+        """``infos`` the gymnasium way: each field's column with its ``_field`` mask (``mask``, shared)."""
+        infos = {}
+        for name in self.info_fields:
+            infos[name] = columns[name]
+            # numpy masks one per field, as gymnasium's own vector envs give them; a torch mask is shared.
+            infos[f"_{name}"] = mask.copy() if isinstance(mask, np.ndarray) else mask
+        return infos
