@@ -63,6 +63,7 @@ def test_the_heatmap_scale_is_the_episodes_own():
     assert image.get_clim() == pytest.approx((-0.0891, 0.0891), abs=2e-3)
 
 
+@pytest.mark.slow
 def test_video_of_a_trained_run_and_flags_that_contradict_it(tmp_path):
     run = tiny_run(tmp_path, "tiny")
     out = tmp_path / "run.mp4"
@@ -75,6 +76,7 @@ def test_video_of_a_trained_run_and_flags_that_contradict_it(tmp_path):
         record.main([str(tmp_path / "nothing"), "--out", str(out)])
 
 
+@pytest.mark.slow
 def test_hidden_state_analysis_of_a_random_policy_on_two_colour(tmp_path):
     out = tmp_path / "analysis"
     analysis.main(["random", "--scenario", "two_colour", "--complexity", "3", "--episodes", "3", "--max-steps", "40",
@@ -115,6 +117,7 @@ def test_totem_probe_reads_the_colour_only_where_the_state_carries_it():
     assert analysis.totem_probe(carried, green, episode_of, episode_of < 3) is None
 
 
+@pytest.mark.slow
 def test_tsne_keeps_at_most_the_asked_number_of_states(tmp_path):
     out = tmp_path / "analysis"
     run = tiny_run(tmp_path, "tiny")
@@ -128,6 +131,7 @@ def test_tsne_keeps_at_most_the_asked_number_of_states(tmp_path):
     picture(out / "tsne.png")
 
 
+@pytest.mark.slow
 def test_learning_curves_average_seeds_with_train_and_test_evaluations(tmp_path, monkeypatch):
     # Random agents die within ~100 steps in Two-colour: training episodes end in a tiny run.
     runs = [tiny_run(tmp_path, f"tc_s{seed}", scenario="two_colour", size=None, complexity=3, seed=seed,

@@ -58,6 +58,7 @@ PAPER_TABLE = (
 
 
 @pytest.mark.parametrize("env_id, kwargs", PAPER_TABLE)
+@pytest.mark.slow
 def test_check_env_passes_without_warnings(env_id, kwargs):
     env = gymnasium.make(env_id, split="train", render_mode="rgb_array", **kwargs)
     with warnings.catch_warnings():

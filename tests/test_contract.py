@@ -76,6 +76,7 @@ def test_a_fifth_scenario_through_gymnasium_and_check_env():
     env.close()
 
 
+@pytest.mark.slow
 def test_a_fifth_scenario_in_the_vector_env():
     # Its workers are separate processes: the scenario reaches them with the env.
     envs = gymnasium.make_vec("mjmaze_test/Beacon-v0", num_envs=4, vectorization_mode="vector_entry_point", num_workers=2)
@@ -113,6 +114,7 @@ def test_registering_a_clashing_scenario_is_one_clear_error():
 
 @pytest.mark.parametrize("module", ["mjmaze.registry", "mjmaze.configs", "mjmaze.layouts", "mjmaze.tasks.base",
                                     "mjmaze.tasks.two_colour", "mjmaze.suite"])
+@pytest.mark.slow
 def test_every_module_imports_first(module):
     # An import cycle shows as an ImportError when the wrong module comes first.
     out = subprocess.run([sys.executable, "-c", f"import {module}"], capture_output=True, text=True, timeout=120)
@@ -131,6 +133,7 @@ def load(name, **kwargs):
     return mjmaze.load(name, task_kwargs={"random": 0, **kwargs})
 
 
+@pytest.mark.slow
 def test_a_full_episode_matches_the_specs(name):
     env = load(name)
     spec = env.observation_spec()["pixels"]
@@ -150,6 +153,7 @@ def test_a_full_episode_matches_the_specs(name):
     env.task.close()
 
 
+@pytest.mark.slow
 def test_turning_in_place_ends_at_the_limit_with_discount_one_or_earlier_with_zero(name):
     env = load(name)
     timestep, steps = env.reset(), 0

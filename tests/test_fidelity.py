@@ -36,6 +36,7 @@ def distinct_colours(frame):
 
 
 @pytest.mark.parametrize("style, fewest", [("textured", 48), ("flat", 1)])
+@pytest.mark.slow
 def test_frames_on_a_random_walk_have_dozens_of_colours(style, fewest):
     env = load("labyrinth", size=9, visual_style=style)
     actions = np.random.default_rng(0).integers(5, size=150)

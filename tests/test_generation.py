@@ -80,6 +80,7 @@ REFERENCE_DIGEST = "93b48dcd91c84b0aa01b162df6270c5d43b4360e1dd515bba00dc9ef144a
 
 
 @pytest.mark.parametrize("size", labyrinth.SIZES)
+@pytest.mark.slow
 def test_train_and_test_configurations_are_disjoint(size):
     train = configs.ConfigSet("labyrinth", size, "train", spec(size))
     test = configs.ConfigSet("labyrinth", size, "test", spec(size))
@@ -109,6 +110,7 @@ def interior_walls(config):
 
 
 @pytest.mark.parametrize("scenario, kwargs", PAPER_SETTINGS, ids=lambda v: str(v))
+@pytest.mark.slow
 def test_train_and_test_are_draws_of_one_distribution(scenario, kwargs):
     from scipy.stats import ks_2samp
 

@@ -60,6 +60,7 @@ def test_the_released_weights_are_mjmaze_agents_layer_for_layer(released):
                                                                   weights["policy.bias"]), atol=1e-5)
 
 
+@pytest.mark.slow
 def test_the_released_labyrinth_agent_solves_released_mazes_and_an_untrained_one_does_not(released, tmp_path):
     # The first 16 test mazes of Labyrinth 7, each played twice, greedily. The
     # released agent solves 98% of the 64 in ViZDoom (tools/paper_agents_vizdoom.py);
@@ -126,6 +127,7 @@ def test_first_use_downloads_into_the_cache_once_and_checks_the_file(released, m
     assert not (tmp_path / "cache" / "mjmaze" / "paper" / "agents" / other.checkpoint).exists()
 
 
+@pytest.mark.slow
 def test_curves_draw_a_paper_agents_level_beside_runs(released, tmp_path):
     from mjmaze.train import curves
 

@@ -37,6 +37,7 @@ class _Parsed(Exception):
 
 
 @pytest.mark.parametrize("code", blocks("python"), ids=lambda code: code.splitlines()[0][:40])
+@pytest.mark.slow
 def test_every_python_block_runs(code, tmp_path):
     script = tmp_path / "snippet.py"
     script.write_text(code)

@@ -35,6 +35,7 @@ def _render_with(backend, tmp_path):
     not (render._egl_device_available() and render._osmesa_available()),
     reason="needs both EGL and OSMesa (newer Mesa releases ship no OSMesa)",
 )
+@pytest.mark.slow
 def test_egl_and_osmesa_both_render_the_same_scene(tmp_path):
     egl_backend, egl = _render_with("egl", tmp_path)
     osmesa_backend, osmesa = _render_with("osmesa", tmp_path)
@@ -76,6 +77,7 @@ def test_egl_is_the_default_where_it_works(monkeypatch):
     assert render.choose_backend() == "egl"
 
 
+@pytest.mark.slow
 def test_the_backend_this_machine_has_renders(tmp_path):
     expected = "egl" if render._egl_device_available() else "osmesa"
     backend, frames = _render_with(expected, tmp_path)
@@ -112,6 +114,7 @@ def _backends_here():
 
 @pytest.mark.parametrize("order", sorted(_FIRST_IMPORTS))
 @pytest.mark.parametrize("backend", ["egl", "osmesa"])
+@pytest.mark.slow
 def test_importing_triton_after_rendering_does_not_crash(backend, order):
     from mjmaze import llvm_clash
 

@@ -108,6 +108,7 @@ def test_two_update_smoke_run_writes_a_run_folder(tmp_path):
     assert [p.name for p in checkpoint.checkpoints(run / "checkpoints")] == ["step_000000000016.pt", "step_000000000032.pt"]
 
 
+@pytest.mark.slow
 def test_resume_continues_step_count_and_optimizer_state(tmp_path):
     run = a2c.train(tiny(tmp_path, total_steps=32, keep_checkpoints=1))
     saved = checkpoint.load(checkpoint.checkpoints(run / "checkpoints")[-1])
@@ -132,6 +133,7 @@ def test_a_missing_checkpoint_is_named_as_missing(tmp_path):
         checkpoint.load(tmp_path / "checkpoints" / "step_000000000064.pt")
 
 
+@pytest.mark.slow
 def test_a_corrupt_checkpoint_is_a_clear_error_and_stays_untouched(tmp_path):
     run = a2c.train(tiny(tmp_path))
     latest = checkpoint.checkpoints(run / "checkpoints")[-1]
@@ -144,6 +146,7 @@ def test_a_corrupt_checkpoint_is_a_clear_error_and_stays_untouched(tmp_path):
                   "--num-steps", "8", "--total-steps", "64", "--resume", "--no-progress"])
 
 
+@pytest.mark.slow
 def test_a_checkpoint_of_another_run_is_refused(tmp_path):
     run = a2c.train(tiny(tmp_path))
     latest = checkpoint.checkpoints(run / "checkpoints")[-1]
@@ -209,6 +212,7 @@ def test_flags_for_another_scenario_are_refused():
         run_settings.Args(scenario="labyrinth", complexity=3).task_kwargs()
 
 
+@pytest.mark.slow
 def test_evaluation_plays_every_configuration_twice(tmp_path, monkeypatch):
     run = a2c.train(tiny(tmp_path))
     monkeypatch.setattr(evaluate, "EVAL_CONFIGS", 8)
@@ -221,6 +225,7 @@ def test_evaluation_plays_every_configuration_twice(tmp_path, monkeypatch):
     assert saved["test"]["episodes"] == 16 and saved["units"] == "success %"
 
 
+@pytest.mark.slow
 def test_a_random_policy_is_evaluated_the_same_way(tmp_path, monkeypatch):
     monkeypatch.setattr(evaluate, "EVAL_CONFIGS", 4)
     out = tmp_path / "random_k2.json"
@@ -254,6 +259,7 @@ def start_training(tmp_path, name: str, *flags: str):
     return process, log
 
 
+@pytest.mark.slow
 def test_sigterm_saves_a_final_checkpoint(tmp_path):
     import os
     import signal
@@ -281,6 +287,7 @@ def _env_workers(pid: int) -> list[int]:
     return workers
 
 
+@pytest.mark.slow
 def test_a_killed_env_worker_costs_the_run_nothing_but_its_rollout(tmp_path):
     import os
     import signal
@@ -297,6 +304,7 @@ def test_a_killed_env_worker_costs_the_run_nothing_but_its_rollout(tmp_path):
     assert checkpoint.load(checkpoint.checkpoints(tmp_path / "kill" / "checkpoints")[-1])["step"] == 1600
 
 
+@pytest.mark.slow
 def test_workers_that_keep_dying_end_in_a_checkpoint_and_one_line(tmp_path, monkeypatch):
     from mjmaze import vector
 
@@ -318,6 +326,7 @@ def test_workers_that_keep_dying_end_in_a_checkpoint_and_one_line(tmp_path, monk
     assert checkpoint.load(saved[-1])["step"] == 4
 
 
+@pytest.mark.slow
 def test_the_main_job_trains_evaluates_beside_chance_draws_films_and_says_so(tmp_path, monkeypatch, capsys):
     from mjmaze.train import first_run
 

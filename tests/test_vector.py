@@ -58,6 +58,7 @@ def _run_to_time_limit(envs, num_envs):
     return obs, rewards, terminated, truncated, infos
 
 
+@pytest.mark.slow
 def test_next_step_autoreset():
     envs = MazeVectorEnv(2, "labyrinth", size=5, autoreset_mode="next_step")
     envs.reset(seed=1)
@@ -72,6 +73,7 @@ def test_next_step_autoreset():
     envs.close()
 
 
+@pytest.mark.slow
 def test_same_step_autoreset_reports_the_final_observation():
     envs = MazeVectorEnv(2, "labyrinth", size=5, autoreset_mode="same_step")
     envs.reset(seed=1)
@@ -89,6 +91,7 @@ def test_same_step_autoreset_reports_the_final_observation():
     envs.close()
 
 
+@pytest.mark.slow
 def test_same_seeds_give_bit_identical_batches():
     def run():
         envs = MazeVectorEnv(4, "k_item", num_items=2, config_sampling="random")
@@ -115,6 +118,7 @@ def test_each_env_gets_its_own_seed():
     "scenario, kwargs",
     [("find_return", {"size": 5}), ("k_item", {"num_items": 4}), ("two_colour", {"complexity": 3})],
 )
+@pytest.mark.slow
 def test_every_scenario_runs(scenario, kwargs):
     envs = MazeVectorEnv(2, scenario, **kwargs)
     envs.reset(seed=0)
@@ -124,6 +128,7 @@ def test_every_scenario_runs(scenario, kwargs):
     envs.close()
 
 
+@pytest.mark.slow
 def test_a_killed_worker_is_a_clear_error_not_a_hang():
     envs = MazeVectorEnv(4, "labyrinth", size=5, num_workers=2)
     envs.reset(seed=0)
@@ -135,6 +140,7 @@ def test_a_killed_worker_is_a_clear_error_not_a_hang():
     assert not any(p.is_alive() for p in envs._processes)
 
 
+@pytest.mark.slow
 def test_an_exception_in_a_task_names_the_worker_and_the_error():
     envs = MazeVectorEnv(2, "labyrinth", size=5, num_workers=2)
     envs.reset(seed=0)
@@ -172,6 +178,7 @@ time.sleep(300)
 """
 
 
+@pytest.mark.slow
 def test_kill_9_of_everything_leaves_no_shared_memory():
     import subprocess
     import sys
@@ -200,6 +207,7 @@ def test_bad_arguments_fail_in_the_calling_process():
         MazeVectorEnv(2, "doom")
 
 
+@pytest.mark.slow
 def test_where_an_env_is_stepped_changes_nothing():
     def run(**where):
         envs = MazeVectorEnv(4, "two_colour", complexity=1, **where)
@@ -245,6 +253,7 @@ if __name__ == "__main__":
 """
 
 
+@pytest.mark.slow
 def test_workers_do_not_import_the_callers_script_or_torch(tmp_path):
     pytest.importorskip("torch")
     import subprocess
