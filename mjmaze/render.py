@@ -31,53 +31,6 @@ HIDDEN_GROUP = 5
 _VISIBLE_GROUPS = (1, 1, 1, 0, 0, 0)
 
 
-# The pistol the released runs saw over the bottom of the view (their .cfg:
-# render_weapon = true): ViZDoom draws Freedoom's pistol and hand there, ~3% of a
-# 112x64 frame, in front of a floor item right ahead. Drawn as its two parts'
-# boxes, (left, right, top, bottom) as fractions of the frame, in their mean
-# colours as ViZDoom draws them (docs/look.md).
-PISTOL = (
-    ((0.472, 0.541, 0.644, 0.806), (55, 51, 49)),  # the gun
-    ((0.444, 0.569, 0.806, 1.0), (92, 63, 36)),  # the hand holding it
-)
-
-
-def pistol_boxes(width: int, height: int, shift: tuple[int, int] = (0, 0)) -> list[tuple[slice, slice, np.ndarray]]:
-    """``[(rows, cols, rgb)]``: the pistol's parts as slices of a ``height x width`` frame.
-
-    ``shift``: pixels (right, down) the pistol has swayed (head-bob), cut at the frame's edges.
-    """
-    dx, dy = shift
-    return [
-        (slice(max(0, round(top * height) + dy), max(0, round(bottom * height) + dy)),
-         slice(max(0, round(left * width) + dx), max(0, round(right * width) + dx)),
-         np.array(rgb, dtype=np.uint8))
-        for (left, right, top, bottom), rgb in PISTOL
-    ]
-
-
-def pistol_pixels(width: int, height: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(rows, cols, rgb)`` of each of the pistol's pixels (for masks in tests and docs)."""
-    rows, cols, colours = [], [], []
-    for r, c, rgb in pistol_boxes(width, height):
-        grid_r, grid_c = np.mgrid[r, c]
-        rows.append(grid_r.ravel())
-        cols.append(grid_c.ravel())
-        colours.append(np.tile(rgb, (grid_r.size, 1)))
-    return np.concatenate(rows), np.concatenate(cols), np.concatenate(colours)
-
-
-def tint(xp, frames, rgb, alpha):
-    """``frames`` (uint8 ``(..., H, W, 3)``) under a full-screen tint: ``rgb`` ``(..., 3)`` at opacity ``alpha`` ``(...)``.
-
-    Doom's flashes (:func:`mjmaze.rules.flash`), on numpy frames or torch
-    batches alike; returns new uint8 frames, rounded as GL blends.
-    """
-    alpha = xp.astype(alpha, xp.float32)[..., None, None, None]
-    over = (xp.astype(rgb, xp.float32) * alpha[..., 0, 0, :])[..., None, None, :]
-    return xp.astype(xp.floor(xp.astype(frames, xp.float32) * (1 - alpha) + over + 0.5), xp.uint8)
-
-
 class GLBackendError(RuntimeError):
     """No headless OpenGL backend could be started."""
 
@@ -236,18 +189,14 @@ class EgoRenderer:
     context (meshes are per model, and the wall mesh is rewritten per maze).
     """
 
-    def __init__(
-        self, model: mujoco.MjModel, camera: str, width: int, height: int, map_view: bool = False, pistol: bool = False
-    ):
+    def __init__(self, model: mujoco.MjModel, camera: str, width: int, height: int, map_view: bool = False):
         """``map_view``: for top-down maps, light the scene evenly from straight
         above instead of with the model's lights (the textured style's lamp sits
         at the agent's eye and fades with distance), and draw no textures, so
-        the floor is one colour under drawn paths. ``pistol``: draw
-        :data:`PISTOL` over each frame (not over :meth:`segmentation`)."""
+        the floor is one colour under drawn paths. What Doom draws over the
+        scene (pistol, flashes) is :mod:`mjmaze.look`'s."""
         gl_context()
         self._map_view = map_view
-        self._pistol = pistol_boxes(width, height) if pistol else []
-        self._swayed_pistol = {(0, 0): self._pistol}
         model.vis.global_.offwidth = max(model.vis.global_.offwidth, width)
         model.vis.global_.offheight = max(model.vis.global_.offheight, height)
         self._model = model
@@ -283,12 +232,11 @@ class EgoRenderer:
         """Re-sends a mesh whose vertices changed in the model."""
         mujoco.mjr_uploadMesh(self._model, self._context, mesh_id)
 
-    def render(self, data: mujoco.MjData, pistol: bool = True, pistol_shift: tuple[int, int] = (0, 0)) -> np.ndarray:
+    def render(self, data: mujoco.MjData) -> np.ndarray:
         """Renders the current state; the result is a view into a reused buffer.
 
         Positions are brought up to date first: after ``mj_step`` they lag
         ``qpos`` by one tic, and objects may have just been moved.
-        ``pistol_shift``: pixels (right, down) the pistol has swayed.
         """
         mujoco.mj_kinematics(self._model, data)
         mujoco.mj_camlight(self._model, data)
@@ -298,12 +246,6 @@ class EgoRenderer:
         mujoco.mjr_setBuffer(self._offscreen, self._context)
         mujoco.mjr_render(self._viewport, self._scene, self._context)
         mujoco.mjr_readPixels(self._buffer, None, self._viewport, self._context)
-        if pistol and self._pistol:
-            boxes = self._swayed_pistol.get(pistol_shift)
-            if boxes is None:  # head-bob sways it over a few dozen shifts: each computed once
-                boxes = self._swayed_pistol[pistol_shift] = pistol_boxes(*self._frame.shape[1::-1], pistol_shift)
-            for rows, cols, rgb in boxes:
-                self._frame[rows, cols] = rgb
         return self._frame
 
     def segmentation(self, data: mujoco.MjData) -> np.ndarray:
@@ -312,7 +254,7 @@ class EgoRenderer:
         for flag in flags:
             self._scene.flags[flag] = 1
         try:
-            colours = self.render(data, pistol=False).astype(np.int64)
+            colours = self.render(data).astype(np.int64)
         finally:
             for flag in flags:
                 self._scene.flags[flag] = 0

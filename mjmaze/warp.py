@@ -44,8 +44,7 @@ from gymnasium.vector import AutoresetMode
 
 import mujoco_warp as mjw
 import warp as wp
-from mjmaze import batch, mjcf, rules, suite
-from mjmaze.render import pistol_boxes, tint
+from mjmaze import batch, look, mjcf, rules, suite
 from mjmaze.tasks import base
 
 # Where a geom that must not be seen or touched in a world goes (below the floor).
@@ -218,11 +217,6 @@ class MazeBatchEnv(batch.BatchEnv):
         self._cam_pos = wp.to_torch(self._model.cam_pos)  # per world with head-bob
         self._camera = mujoco.mj_name2id(mjm, mujoco.mjtObj.mjOBJ_CAMERA, base.CAMERA)
         self._rgb_packed = wp.to_torch(self._render.rgb_data)
-        # The pistol over each frame, as the CPU renderer draws it (mjmaze.render.PISTOL).
-        self._pistol = [
-            (rows, cols, torch.as_tensor(rgb, device=dev))
-            for rows, cols, rgb in (pistol_boxes(width, height) if task.draws_pistol else [])
-        ]
         self._stream = wp.stream_from_torch(torch.cuda.current_stream(dev)) if dev.type == "cuda" else None
 
         self._seed_keys = torch.zeros(n, dtype=torch.int64, device=dev)
@@ -232,8 +226,6 @@ class MazeBatchEnv(batch.BatchEnv):
         self._path = torch.zeros((n, base.TICS_PER_STEP, 2), dtype=torch.float64, device=dev)
         self._turn_held = torch.zeros(n, dtype=torch.float64, device=dev)  # tics a turn key has been held
         self._bob = torch.zeros(n, dtype=torch.float64, device=dev)  # Doom's walking bob of the last tic
-        self._rows = torch.arange(height, device=dev)
-        self._cols = torch.arange(width, device=dev)
         self._obs = torch.zeros((n, height, width, 3), dtype=torch.uint8, device=dev)
         self.state: dict[str, torch.Tensor] | None = None
 
@@ -319,7 +311,7 @@ class MazeBatchEnv(batch.BatchEnv):
             qpos[:, :2] -= ahead
             qvel[:, :2] *= base.FRICTION
             self._path[:, tic] = qpos[:, :2]
-        self._bob = base.walking_bob(self.xp, vx, vy, dt)
+        self._bob = look.walking_bob(self.xp, vx, vy, dt)
 
     def _start_episodes(self, restart: torch.Tensor) -> None:
         """New episodes where ``restart`` ``(N,)`` is set: configuration, the scenario's start, the arena.
@@ -394,33 +386,25 @@ class MazeBatchEnv(batch.BatchEnv):
         if not self._rendering:
             return
         m, d, rc = self._model, self._data, self._render
-        if self.task.head_bob:
-            eye_dz, pistol_dx, pistol_dy = base.view_bob(self.xp, self._bob, self.state["steps"] * base.TICS_PER_STEP)
+        task = self.task
+        if task.head_bob:
+            eye_dz, pistol_dx, pistol_dy = look.view_bob(self.xp, self._bob, self.state["steps"] * base.TICS_PER_STEP)
             self._cam_pos[:, self._camera, 2] = (mjcf.EYE_HEIGHT + eye_dz).float()
         mjw.kinematics(m, d)  # positions lag a step behind mjw.step's integration
         mjw.camlight(m, d)
         mjw.refit_bvh(m, d, rc)
         mjw.render(m, d, rc)
         # Packed 0xAABBGGRR per pixel: bytes R, G, B, A in memory.
-        packed = self._rgb_packed.view(torch.uint8).view(self.num_envs, self.task.height, self.task.width, 4)
+        packed = self._rgb_packed.view(torch.uint8).view(self.num_envs, task.height, task.width, 4)
         self._obs.copy_(packed[..., [2, 1, 0]])
-        if self.task.head_bob and self._pistol:
-            self._draw_swayed_pistol(torch.round(pistol_dx * self.task.width).long(),
-                                     torch.round(pistol_dy * self.task.height).long())
-        else:
-            for rows, cols, rgb in self._pistol:
-                self._obs[:, rows, cols] = rgb
-        if self.task.flashes:  # every world, flashed or not: picking the flashed ones out would wait on the GPU
-            rgb, alpha = rules.flash(self.xp, self.state["damage_count"], self.state["bonus_count"])
-            self._obs.copy_(tint(self.xp, self._obs, rgb, alpha))
-
-    def _draw_swayed_pistol(self, dx: torch.Tensor, dy: torch.Tensor) -> None:
-        """The pistol's boxes, each env's shifted by its own ``(dx, dy)`` pixels (as :func:`mjmaze.render.pistol_boxes`)."""
-        for rows, cols, rgb in self._pistol:
-            in_rows = (self._rows >= rows.start + dy[:, None]) & (self._rows < rows.stop + dy[:, None])  # (N, H)
-            in_cols = (self._cols >= cols.start + dx[:, None]) & (self._cols < cols.stop + dx[:, None])  # (N, W)
-            inside = in_rows[:, :, None, None] & in_cols[:, None, :, None]
-            torch.where(inside, rgb, self._obs, out=self._obs)  # no boolean indexing: it would wait on the GPU
+        # What Doom draws over the scene, as on the CPU (mjmaze.look).
+        if task.draws_pistol:
+            still = torch.zeros(self.num_envs, dtype=torch.long, device=self.device)
+            dx = torch.round(pistol_dx * task.width).long() if task.head_bob else still
+            dy = torch.round(pistol_dy * task.height).long() if task.head_bob else still
+            look.draw_pistol(self.xp, self._obs, dx, dy)
+        if task.flashes:  # every world, flashed or not: picking the flashed ones out would wait on the GPU
+            self._obs.copy_(look.flash(self.xp, self._obs, self.state["damage_count"], self.state["bonus_count"]))
 
     def segmentation(self) -> torch.Tensor:
         """``(N, H, W)`` geom id drawn at each pixel of the last frames, -1 for none (needs ``render_segmentation``)."""

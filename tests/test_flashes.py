@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import mjmaze
-from mjmaze import render, rules
+from mjmaze import look, rules
 from mjmaze.tasks import two_colour
 
 from conftest import TURN_LEFT, place
@@ -36,7 +36,7 @@ def step_both(envs, action=TURN_LEFT, xy=None):
 
 def tinted(frame, damage, bonus):
     rgb, alpha = rules.flash(np, np.array([damage]), np.array([bonus]))
-    return render.tint(np, frame.astype(np.uint8), rgb[0], alpha[0]).astype(int)
+    return look.tint(np, frame.astype(np.uint8), rgb[0], alpha[0]).astype(int)
 
 
 def counts(env):
@@ -57,7 +57,7 @@ def test_the_opacities_are_zdooms():
     frame = np.full((2, 2, 3), (15, 21, 15), dtype=np.uint8)
     rgb, alpha = rules.flash(np, np.array([7]), np.array([0]))
     # ViZDoom's mean frame went from (15, 21, 15) to (58, 16-17, 11): within a level.
-    assert render.tint(np, frame, rgb[0], alpha[0])[0, 0].tolist() == pytest.approx([58, 17, 11], abs=1)
+    assert look.tint(np, frame, rgb[0], alpha[0])[0, 0].tolist() == pytest.approx([58, 17, 11], abs=1)
 
 
 def test_each_lava_hit_flashes_the_view_red_for_two_steps():
@@ -116,7 +116,7 @@ def test_a_k_item_pickup_flashes_gold():
 
 
 def test_labyrinth_never_flashes_and_no_scenario_draws_the_pistol():
-    hand = render.pistol_boxes(1, 1)[1][2]
+    hand = look.pistol_boxes(1, 1)[1][2]
     for name, kwargs in (("labyrinth", {"size": 5}), ("find_return", {"size": 5}), ("k_item", {"num_items": 2}),
                          ("two_colour", {"complexity": 1})):
         flashed, plain = step_both(twins(name, **kwargs))

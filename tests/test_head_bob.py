@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from mjmaze import mjcf, render
+from mjmaze import look, mjcf
 from mjmaze.tasks import base, two_colour
 
 # Actions as ViZDoom played them: forward 12 steps, nothing 8, forward 15, nothing 10.
@@ -55,7 +55,7 @@ def eye_units(env):
 def pistol_corner(env):
     """(top row, left column) of the pistol in the observation (its hand's and gun's own colours)."""
     frame = env.task.get_observation(env.physics)["pixels"]
-    (gun_rows, _, gun), (_, hand_cols, hand) = render.pistol_boxes(1, 1)
+    (gun_rows, _, gun), (_, hand_cols, hand) = look.pistol_boxes(1, 1)
     gun_row = np.nonzero((frame == gun).all(-1).sum(1) >= 10)[0]
     hand_col = np.nonzero((frame == hand).all(-1).sum(0) >= 10)[0]
     return gun_row.min(), hand_col.min()

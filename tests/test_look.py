@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import mjmaze
-from mjmaze import mjcf, render, viz
+from mjmaze import look, mjcf, viz
 from mjmaze.tasks import base, find_return, labyrinth, two_colour
 
 from conftest import find_cell, open_run, place
@@ -65,7 +65,7 @@ def object_colour(env, name, pose):
     """Mean colour where object ``name`` is drawn, seen from ``pose``, outside the pistol."""
     frame = frame_at(env, *pose)
     mask = np.isin(env.task.segmentation(env.physics), env.physics.object_ids([name])[1])
-    rows, cols, _ = render.pistol_pixels(frame.shape[1], frame.shape[0])
+    rows, cols, _ = look.pistol_pixels(frame.shape[1], frame.shape[0])
     mask[rows, cols] = False
     assert mask.sum() >= 10
     return frame[mask].mean(axis=0)
@@ -152,7 +152,7 @@ def test_the_pistol_when_asked_for_hides_a_floor_item_right_ahead():
     physics.place_objects(exit_ids[0], np.array([[0.6, 0.0]]))
     frame = frame_at(env, 0.0, 0.0, 0.0)
     seg = env.task.segmentation(physics)
-    rows, cols, rgb = render.pistol_pixels(frame.shape[1], frame.shape[0])
+    rows, cols, rgb = look.pistol_pixels(frame.shape[1], frame.shape[0])
     assert (frame[rows, cols] == rgb).all()  # drawn over the view
     hidden = np.isin(seg[rows, cols], exit_ids[1]).sum()
     assert hidden >= 10  # the exit is there, behind the pistol
@@ -163,7 +163,7 @@ def test_the_flat_style_draws_no_pistol_and_maps_no_ceiling():
     env = mjmaze.load("labyrinth", task_kwargs={"size": 5, "random": 0, "visual_style": "flat"})
     env.reset()
     frame = env.task.get_observation(env.physics)["pixels"]
-    rows, cols, rgb = render.pistol_pixels(frame.shape[1], frame.shape[0])
+    rows, cols, rgb = look.pistol_pixels(frame.shape[1], frame.shape[0])
     assert not (frame[rows, cols] == rgb).all(axis=1).any()
     env.task.close()
 

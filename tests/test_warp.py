@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import mjmaze
-from mjmaze import mjcf, registry, render, rules, suite
+from mjmaze import look, mjcf, registry, rules, suite
 from mjmaze.tasks import base
 
 pytestmark = [pytest.mark.warp, pytest.mark.slow]
@@ -125,7 +125,7 @@ def test_head_bob_moves_each_worlds_eye_and_pistol_as_the_cpu_task():
     batch = mjwarp.MazeBatchEnv(2, "labyrinth", device="cpu", **kwargs)
     batch.reset(seed=SEED)
     cpus = _cpu_twins("labyrinth", kwargs, 2, batch)
-    _, _, hand = render.pistol_boxes(1, 1)[1]
+    _, _, hand = look.pistol_boxes(1, 1)[1]
     swing = 0.0
     for step in range(16):
         actions = np.array([2, 3 if step < 8 else 0])  # walk; walk left, then turn in place
@@ -156,7 +156,7 @@ def test_flashes_tint_every_world_as_the_cpu_task():
         assert flashed.state["damage_count"].tolist() == [damage, damage], step
         assert info["health"].tolist() == [92 if step < 6 else 84] * 2
         rgb, alpha = rules.flash(flashed.xp, flashed.state["damage_count"], flashed.state["bonus_count"])
-        assert torch.equal(obs, render.tint(flashed.xp, obs_plain, rgb, alpha)), step
+        assert torch.equal(obs, look.tint(flashed.xp, obs_plain, rgb, alpha)), step
         assert torch.equal(obs, obs_plain) == (damage == 0), step
 
 

@@ -32,7 +32,7 @@ import imageio.v3 as iio
 import numpy as np
 
 import mjmaze
-from mjmaze import configs, maze, render
+from mjmaze import configs, look, maze
 from mjmaze.tasks import base, find_return, k_item, two_colour
 
 UNITS = 128  # Doom map units per metre (mjmaze's 1 m cell is the generator's 128 units)
@@ -194,7 +194,7 @@ def mjmaze_view(env, spawn: tuple[float, float, int], objects: list[str]) -> tup
     physics.forward()
     geoms = physics.object_ids(objects)[1]
     mask = np.isin(task.segmentation(physics), geoms).astype(np.float64)
-    rows, cols, _ = render.pistol_pixels(*SIZE)
+    rows, cols, _ = look.pistol_pixels(*SIZE)
     mask[rows, cols] = 0.0  # what the pistol hides
     return task.get_observation(physics)["pixels"].copy(), mask
 

@@ -26,7 +26,7 @@ from dm_control.rl import control
 from dm_control.suite import base
 from dm_env import specs
 
-from mjmaze import configs, mjcf, render, rules
+from mjmaze import configs, look, mjcf, render, rules
 from mjmaze import layouts as layout_files
 
 # Timing: one physics step is one Doom tic (35 a second); the agent acts every 4 tics.
@@ -48,17 +48,6 @@ SLOW_TURN_TICS = 5  # a turn key's first tics turn at half rate (ZDoom's SLOWTUR
 # At full speed in open space: 0.261 m and 14.06 degrees per agent step.
 FORWARD_PER_STEP = TICS_PER_STEP * THRUST_PER_TIC / (1 - FRICTION)
 TURN_PER_STEP = TICS_PER_STEP * TURN_PER_TIC
-# Head-bob (``head_bob=True``): Doom's P_CalcHeight and P_BobWeapon, measured in
-# ViZDoom (docs/look.md). Walking swings the eye by half the "bob", min(v^2 / 4, 16)
-# map units with v the speed after the tic's thrust in units per tic, with a
-# 20-tic period, and drops and sways the pistol by the whole bob (in 320x180
-# screen pixels) with a 64-tic period. The phases run on the level's clock,
-# which the released configs start at tic 10.
-MAX_BOB = 16.0  # map units (Doom's MAXBOB)
-EPISODE_START_TIC = 10  # the released .cfg files' episode_start_time
-EYE_BOB_TICS = 20
-PISTOL_BOB_TICS = 64
-PISTOL_BOB_PIXELS = (0.751 / 320, 0.903 / 180)  # (x, y) shift per unit of bob, as fractions of the frame
 PICKUP_RADIUS = rules.PICKUP_RADIUS
 AGENT_RADIUS = 0.125
 
@@ -91,7 +80,7 @@ class MazePhysics(mujoco.Physics):
     command: tuple[int, int] = (0, 0)
     #: Tics a turn key has been held without a break (Doom's slow start of a turn).
     turn_held: int = 0
-    #: Doom's walking bob (map units) of the last tic: see :func:`view_bob`.
+    #: Doom's walking bob (map units) of the last tic: see :func:`mjmaze.look.view_bob`.
     bob: float = 0.0
 
     def step(self, nstep: int = 1) -> None:
@@ -133,7 +122,7 @@ class MazePhysics(mujoco.Physics):
         qvel[0], qvel[1] = vx, vy
         self.turn_held = held
         if nstep:
-            self.bob = float(walking_bob(np, thrust_vx, thrust_vy, dt))
+            self.bob = float(look.walking_bob(np, thrust_vx, thrust_vy, dt))
 
     def agent_pose(self) -> tuple[float, float, float]:
         """``(x, y, yaw)`` of the agent; yaw in radians in ``(-pi, pi]``, 0 facing +x."""
@@ -226,7 +215,7 @@ class MazeTask(base.Task):
         self.visual_style = visual_style
         if not isinstance(head_bob, (bool, np.bool_)):
             raise ValueError(f"head_bob must be True or False, got {head_bob!r}")
-        #: Doom's head-bob while walking: the eye swings, the pistol sways (:func:`view_bob`).
+        #: Doom's head-bob while walking: the eye swings, the pistol sways (:func:`mjmaze.look.view_bob`).
         self.head_bob = bool(head_bob)
         if not isinstance(flashes, (bool, np.bool_)):
             raise ValueError(f"flashes must be True or False, got {flashes!r}")
@@ -288,7 +277,7 @@ class MazeTask(base.Task):
         self._model, self._bound_data = model, data
         self._qpos, self._qvel = data.qpos, data.qvel
         self._walls = mjcf.WallLayout(model, self.layout.grid_size, self.layout.cell_size)
-        self._renderer = render.EgoRenderer(model, CAMERA, self.width, self.height, pistol=self.draws_pistol)
+        self._renderer = render.EgoRenderer(model, CAMERA, self.width, self.height)
         self._eye = model.cam(CAMERA).pos  # a view into the model: head-bob moves it
         fovy = math.radians(model.cam(CAMERA).fovy[0])
         self.horizontal_fov = 2 * math.atan(math.tan(fovy / 2) * self.width / self.height)
@@ -455,7 +444,10 @@ class MazeTask(base.Task):
 
     def get_observation(self, physics: MazePhysics) -> collections.OrderedDict:
         self._bind(physics)
-        frame = self._renderer.render(self._bound_data, pistol_shift=self._bob_view(physics))
+        pistol_shift = self._bob_view(physics)
+        frame = self._renderer.render(self._bound_data)
+        if self.draws_pistol:
+            look.draw_pistol(np, frame[None], *np.array(pistol_shift)[:, None])
         if self.flashes:
             counts = int(self.state["damage_count"][self.row]), int(self.state["bonus_count"][self.row])
             if any(counts):  # most frames have no flash: no work for them
@@ -463,7 +455,7 @@ class MazeTask(base.Task):
                 if tint is None:  # a few dozen pairs occur: each worked out once
                     rgb, alpha = rules.flash(np, np.array(counts[:1]), np.array(counts[1:]))
                     tint = self._tints[counts] = rgb[0], alpha[0]
-                frame[...] = render.tint(np, frame, *tint)
+                frame[...] = look.tint(np, frame, *tint)
         if self.observation_buffer is None:
             return collections.OrderedDict(pixels=frame.copy())
         np.copyto(self.observation_buffer, frame)
@@ -479,7 +471,7 @@ class MazeTask(base.Task):
         """Puts the eye where head-bob has it now; returns the pistol's shift in pixels (right, down)."""
         if not self.head_bob:
             return 0, 0
-        eye_dz, pistol_dx, pistol_dy = view_bob(math, physics.bob, self.steps * TICS_PER_STEP)
+        eye_dz, pistol_dx, pistol_dy = look.view_bob(math, physics.bob, self.steps * TICS_PER_STEP)
         self._eye[2] = mjcf.EYE_HEIGHT + eye_dz
         return round(pistol_dx * self.width), round(pistol_dy * self.height)
 
@@ -561,26 +553,6 @@ def tic_motion(xp, vx, vy, yaw, forward, turn, turn_held, timestep: float):
     heading = yaw + yaw_rate * timestep
     thrust = forward * THRUST_PER_TIC / timestep
     return vx + thrust * xp.cos(heading), vy + thrust * xp.sin(heading), yaw_rate, turn_held
-
-
-def walking_bob(xp, vx, vy, timestep: float):
-    """Doom's bob in map units of a tic whose velocity after its thrust is ``(vx, vy)`` (m/s)."""
-    speed_sq = (vx * vx + vy * vy) * (timestep / MAP_UNIT) ** 2  # (map units per tic)^2
-    return rules.at_most(xp, speed_sq / 4, MAX_BOB)
-
-
-def view_bob(xp, bob, tics):
-    """``(eye_dz, pistol_dx, pistol_dy)`` of ``tics`` tics into an episode whose last tic's bob was ``bob``.
-
-    ``eye_dz`` in metres (up), the pistol's shift as fractions of the frame
-    (right, down). Works on floats (``xp = math``) and arrays, as :func:`tic_motion`.
-    """
-    level_time = EPISODE_START_TIC + tics
-    eye_dz = bob / 2 * xp.sin(math.tau * (level_time - 1) / EYE_BOB_TICS) * MAP_UNIT
-    angle = math.tau * level_time / PISTOL_BOB_TICS
-    pistol_dx = bob * xp.cos(angle) * PISTOL_BOB_PIXELS[0]
-    pistol_dy = bob * abs(xp.sin(angle)) * PISTOL_BOB_PIXELS[1]
-    return eye_dz, pistol_dx, pistol_dy
 
 
 def episode_info(metrics: dict, x, y, yaw, step, episode_return, config_index) -> dict:

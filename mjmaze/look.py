@@ -1,0 +1,117 @@
+"""What Doom draws besides the 3D scene, for both renderers: head-bob, the pistol, the flashes.
+
+The CPU renderer (:class:`mjmaze.render.EgoRenderer`, one frame) and the
+MuJoCo Warp backend (:mod:`mjmaze.warp`, every world's frame at once) draw the
+scene their own way; what comes after is the same array code for both, on
+numpy or torch (``xp``, as :mod:`mjmaze.rules`), in this module. All of it was
+measured in ViZDoom (docs/look.md).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from mjmaze import mjcf, rules
+
+# Head-bob: Doom's P_CalcHeight and P_BobWeapon. Walking swings the eye by half
+# the "bob", min(v^2 / 4, 16) map units with v the speed after the tic's thrust
+# in units per tic, with a 20-tic period, and drops and sways the pistol by the
+# whole bob (in 320x180 screen pixels) with a 64-tic period. The phases run on
+# the level's clock, which the released configs start at tic 10.
+MAX_BOB = 16.0  # map units (Doom's MAXBOB)
+EPISODE_START_TIC = 10  # the released .cfg files' episode_start_time
+EYE_BOB_TICS = 20
+PISTOL_BOB_TICS = 64
+PISTOL_BOB_PIXELS = (0.751 / 320, 0.903 / 180)  # (x, y) shift per unit of bob, as fractions of the frame
+
+# The pistol ViZDoom draws over the bottom of the view where a map gives the
+# player one (none of the released maps does: mjmaze.tasks.base.MazeTask.pistol):
+# Freedoom's pistol and hand, ~3% of a 112x64 frame. Drawn as its two parts'
+# boxes, (left, right, top, bottom) as fractions of the frame, in their mean
+# colours as ViZDoom draws them.
+PISTOL = (
+    ((0.472, 0.541, 0.644, 0.806), (55, 51, 49)),  # the gun
+    ((0.444, 0.569, 0.806, 1.0), (92, 63, 36)),  # the hand holding it
+)
+
+
+def walking_bob(xp, vx, vy, timestep: float):
+    """Doom's bob in map units of a tic whose velocity after its thrust is ``(vx, vy)`` (m/s)."""
+    speed_sq = (vx * vx + vy * vy) * (timestep / mjcf.MAP_UNIT) ** 2  # (map units per tic)^2
+    return rules.at_most(xp, speed_sq / 4, MAX_BOB)
+
+
+def view_bob(xp, bob, tics):
+    """``(eye_dz, pistol_dx, pistol_dy)`` of ``tics`` tics into an episode whose last tic's bob was ``bob``.
+
+    ``eye_dz`` in metres (up), the pistol's shift as fractions of the frame
+    (right, down). Works on floats (``xp = math``) and arrays.
+    """
+    level_time = EPISODE_START_TIC + tics
+    eye_dz = bob / 2 * xp.sin(math.tau * (level_time - 1) / EYE_BOB_TICS) * mjcf.MAP_UNIT
+    angle = math.tau * level_time / PISTOL_BOB_TICS
+    pistol_dx = bob * xp.cos(angle) * PISTOL_BOB_PIXELS[0]
+    pistol_dy = bob * abs(xp.sin(angle)) * PISTOL_BOB_PIXELS[1]
+    return eye_dz, pistol_dx, pistol_dy
+
+
+def pistol_boxes(width: int, height: int, shift: tuple[int, int] = (0, 0)) -> list[tuple[slice, slice, np.ndarray]]:
+    """``[(rows, cols, rgb)]``: the pistol's parts as slices of a ``height x width`` frame.
+
+    ``shift``: pixels (right, down) the pistol has swayed (head-bob), cut at the frame's edges.
+    """
+    dx, dy = shift
+    return [
+        (slice(max(0, round(top * height) + dy), max(0, round(bottom * height) + dy)),
+         slice(max(0, round(left * width) + dx), max(0, round(right * width) + dx)),
+         np.array(rgb, dtype=np.uint8))
+        for (left, right, top, bottom), rgb in PISTOL
+    ]
+
+
+def pistol_pixels(width: int, height: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(rows, cols, rgb)`` of each of the pistol's pixels (for masks in tests and docs)."""
+    rows, cols, colours = [], [], []
+    for r, c, rgb in pistol_boxes(width, height):
+        grid_r, grid_c = np.mgrid[r, c]
+        rows.append(grid_r.ravel())
+        cols.append(grid_c.ravel())
+        colours.append(np.tile(rgb, (grid_r.size, 1)))
+    return np.concatenate(rows), np.concatenate(cols), np.concatenate(colours)
+
+
+def draw_pistol(xp, frames, dx, dy) -> None:
+    """Draws the pistol into ``frames`` (uint8 ``(B, H, W, 3)``, in place), each swayed by its own ``(dx, dy)`` ``(B,)`` pixels.
+
+    As :func:`pistol_boxes` (a box cut at the frame's edges), by masks rather
+    than slices, so a batch's frames each take their own shift without a
+    Python loop over them (no boolean indexing either: on a GPU it would wait
+    for the mask's count).
+    """
+    _, height, width, _ = frames.shape
+    dev = rules.device(frames)
+    rows = xp.arange(height, device=dev)[None, :]
+    cols = xp.arange(width, device=dev)[None, :]
+    for (rows_box, cols_box, _), (_, colour) in zip(pistol_boxes(width, height), PISTOL):
+        in_rows = (rows >= rows_box.start + dy[:, None]) & (rows < rows_box.stop + dy[:, None])  # (B, H)
+        in_cols = (cols >= cols_box.start + dx[:, None]) & (cols < cols_box.stop + dx[:, None])  # (B, W)
+        inside = in_rows[:, :, None, None] & in_cols[:, None, :, None]
+        frames[...] = xp.where(inside, rules.constant(xp, colour, xp.uint8, dev), frames)
+
+
+def tint(xp, frames, rgb, alpha):
+    """``frames`` (uint8 ``(..., H, W, 3)``) under a full-screen tint: ``rgb`` ``(..., 3)`` at opacity ``alpha`` ``(...)``.
+
+    Doom's flashes (:func:`mjmaze.rules.flash`), on numpy frames or torch
+    batches alike; returns new uint8 frames, rounded as GL blends.
+    """
+    alpha = xp.astype(alpha, xp.float32)[..., None, None, None]
+    over = (xp.astype(rgb, xp.float32) * alpha[..., 0, 0, :])[..., None, None, :]
+    return xp.astype(xp.floor(xp.astype(frames, xp.float32) * (1 - alpha) + over + 0.5), xp.uint8)
+
+
+def flash(xp, frames, damage_count, bonus_count):
+    """``frames`` ``(B, H, W, 3)`` under each env's flash, from its counters ``(B,)`` (:func:`mjmaze.rules.flash`)."""
+    return tint(xp, frames, *rules.flash(xp, damage_count, bonus_count))
