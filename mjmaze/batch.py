@@ -18,8 +18,7 @@ import numpy as np
 from gymnasium.vector import AutoresetMode
 from gymnasium.vector.utils import batch_space
 
-from mjmaze import rules
-from mjmaze.tasks import base
+from mjmaze import core, rules
 
 AUTORESET_MODES = {"next_step": AutoresetMode.NEXT_STEP, "same_step": AutoresetMode.SAME_STEP}
 
@@ -70,7 +69,7 @@ class BatchEnv(gym.vector.VectorEnv):
         self,
         num_envs: int,
         scenario: str,
-        task: base.MazeTask,
+        task: core.MazeRules,
         autoreset_mode: str | AutoresetMode,
         render_modes: Sequence[str],
     ) -> None:
@@ -81,12 +80,12 @@ class BatchEnv(gym.vector.VectorEnv):
         self.num_envs = int(num_envs)
         self.scenario = scenario
         self.autoreset_mode = mode
-        self.metadata = {"autoreset_mode": mode, "render_modes": list(render_modes), "render_fps": base.STEPS_PER_SECOND}
+        self.metadata = {"autoreset_mode": mode, "render_modes": list(render_modes), "render_fps": core.STEPS_PER_SECOND}
         self.single_observation_space = gym.spaces.Box(0, 255, (task.height, task.width, 3), np.uint8)
         self.single_action_space = gym.spaces.Discrete(len(task.actions))
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
-        #: The names and Python types of the ``info`` fields, in order (:meth:`mjmaze.tasks.base.MazeTask.info_fields`).
+        #: The names and Python types of the ``info`` fields, in order (:meth:`mjmaze.core.MazeRules.info_fields`).
         self.info_fields: dict[str, type] = task.info_fields()
         self.closed = False
 

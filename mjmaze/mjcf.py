@@ -91,6 +91,7 @@ _TEXTURE_GAIN = {"wall": 1.35, "floor": 1.6}
 WALL_THICKNESS = 0.125
 WALL_HEIGHT = 1.0
 WALL_MESH = "walls"
+EGO_CAMERA = "ego"  # the agent's eye (xml_templates/arena.xml)
 OVERHEAD_CAMERA = "overhead"
 OVERHEAD_HEIGHT = 10.0
 LAMP = "lamp"

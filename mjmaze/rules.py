@@ -1,7 +1,7 @@
 """Array functions the scenarios' rules are written with, for a batch of envs at once.
 
-Every scenario states its rules once (:meth:`mjmaze.tasks.base.MazeTask.start`
-and :meth:`~mjmaze.tasks.base.MazeTask.rules`) as operations on arrays whose
+Every scenario states its rules once (:meth:`mjmaze.core.MazeRules.start`
+and :meth:`~mjmaze.core.MazeRules.rules`) as operations on arrays whose
 first axis is the env: the CPU task calls them on numpy arrays with a batch of
 one, the MuJoCo Warp backend (:mod:`mjmaze.warp`) on torch tensors with
 thousands of envs on the GPU. ``xp`` is the array namespace

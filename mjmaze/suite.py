@@ -15,7 +15,7 @@ import pkgutil
 import gymnasium
 from dm_control.rl import control
 
-from mjmaze import registry, tasks
+from mjmaze import core, registry, tasks
 from mjmaze.tasks import base
 
 
@@ -62,16 +62,31 @@ def _parameters(function, skip=("self", "kwargs", "difficulty", "layout")) -> tu
 
 def task_kwarg_names(name: str) -> tuple[str, ...]:
     """The task arguments scenario ``name`` accepts."""
-    return _parameters(registry.get(name).task.__init__) + _parameters(base.MazeTask.__init__)
+    return _parameters(registry.get(name).task.__init__) + _parameters(core.MazeRules.__init__) + ("random",)
 
 
-def make_task(name: str, task_kwargs: dict | None = None) -> base.MazeTask:
-    """The task of scenario ``name`` alone (no physics, no rendering yet); checks its arguments."""
+def _checked(name: str, task_kwargs: dict | None) -> dict:
     task_kwargs = dict(task_kwargs or {})
     valid = task_kwarg_names(name)
     unknown = sorted(set(task_kwargs) - set(valid))
     if unknown:
         raise ValueError(f"unknown task argument(s) {unknown} for {name!r}; valid: {valid}")
+    return task_kwargs
+
+
+def make_task(name: str, task_kwargs: dict | None = None) -> base.MazeTask:
+    """The dm_control task of scenario ``name`` (no physics, no rendering yet); checks its arguments."""
+    return base.task_class(registry.get(name).task)(**_checked(name, task_kwargs))
+
+
+def make_rules(name: str, task_kwargs: dict | None = None) -> core.MazeRules:
+    """Scenario ``name``'s core alone: its settings, mazes and batched rules, for a batch simulator.
+
+    Takes the task arguments of :func:`make_task` (``random``, the seed of a
+    dm_control task's episodes, has no use here: a batch env seeds its envs at ``reset``).
+    """
+    task_kwargs = _checked(name, task_kwargs)
+    task_kwargs.pop("random", None)
     return registry.get(name).task(**task_kwargs)
 
 

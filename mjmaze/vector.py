@@ -335,7 +335,7 @@ class MazeVectorEnv(batch.BatchEnv):
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
         # Checks the arguments here, in this process, and tells shapes and info fields.
-        probe = suite.make_task(scenario, task_kwargs)
+        probe = suite.make_rules(scenario, task_kwargs)
         self._setup(num_envs, scenario, probe, autoreset_mode, render_modes=["rgb_array"])
         self.render_mode = render_mode
         usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1

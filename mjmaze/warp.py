@@ -9,10 +9,10 @@ tensors on ``device``; reached from the registry by one word::
 
 It plays the same task as the CPU envs: the same configurations (splits,
 ``num_configs``, imported layouts), the scenario's own rules
-(:meth:`mjmaze.tasks.base.MazeTask.start` and
-:meth:`~mjmaze.tasks.base.MazeTask.rules`, called here on torch tensors with a
+(:meth:`mjmaze.core.MazeRules.start` and
+:meth:`~mjmaze.core.MazeRules.rules`, called here on torch tensors with a
 batch of all envs), the same agent motion
-(:func:`mjmaze.tasks.base.tic_motion`) and the same per-tic speculative
+(:func:`mjmaze.physics.tic_motion`) and the same per-tic speculative
 contacts; env ``i`` seeded with ``s`` plays the same episodes as a CPU env
 seeded with ``s``. Warp computes in float32, so long runs drift apart by
 rounding (tests/test_warp.py checks the first 100 steps and outcome statistics).
@@ -44,8 +44,7 @@ from gymnasium.vector import AutoresetMode
 
 import mujoco_warp as mjw
 import warp as wp
-from mjmaze import batch, look, mjcf, rules, suite
-from mjmaze.tasks import base
+from mjmaze import batch, core, look, mjcf, physics, rules, suite
 
 # Where a geom that must not be seen or touched in a world goes (below the floor).
 _AWAY_Z = -50.0
@@ -56,7 +55,7 @@ _ARENA_BODY = "arena"
 _COLLISION_SUFFIX = "_collision"
 
 
-def build_model(task: base.MazeTask) -> tuple[mujoco.MjModel, np.ndarray, np.ndarray]:
+def build_model(task: core.MazeRules) -> tuple[mujoco.MjModel, np.ndarray, np.ndarray]:
     """The task's arena as one MuJoCo model for all worlds, with a wall mesh per layout.
 
     Returns ``(model, mesh_of_config (C,), box_z_of_config (C, boxes))``: which
@@ -94,7 +93,7 @@ def build_model(task: base.MazeTask) -> tuple[mujoco.MjModel, np.ndarray, np.nda
             geom.set("pos", f"0 0 {obj.z}")
             arena.append(geom)
         geom = arena.find(f"geom[@name='{obj.name}']")
-        geom.set("group", str(base.VISIBLE_GROUP))
+        geom.set("group", str(physics.VISIBLE_GROUP))
         if obj.collides:
             geom.set("contype", "0")
             geom.set("conaffinity", "0")
@@ -162,7 +161,7 @@ class MazeBatchEnv(batch.BatchEnv):
         wp.config.log_level = max(wp.config.log_level, wp.LOG_WARNING)
         wp.init()
         first = int(task_kwargs.pop("first_config", 0))
-        self.task = task = suite.make_task(scenario, task_kwargs)
+        self.task = task = suite.make_rules(scenario, task_kwargs)
         self._setup(num_envs, scenario, task, autoreset_mode, render_modes=[])
         n = self.num_envs
         self.device = torch.device(device)
@@ -202,7 +201,7 @@ class MazeBatchEnv(batch.BatchEnv):
             self._data = mjw.put_data(mjm, mujoco.MjData(mjm), nworld=n, nconmax=_CONTACTS_PER_WORLD, njmax=_CONTACTS_PER_WORLD)
             self._render = mjw.create_render_context(
                 mjm, nworld=n, cam_res=(width, height), render_rgb=True, render_depth=False,
-                render_seg=render_segmentation, use_textures=True, cam_active=[base.CAMERA],
+                render_seg=render_segmentation, use_textures=True, cam_active=[mjcf.EGO_CAMERA],
                 enabled_geom_groups=[0, 1, 2],
             )
         self._segmentation = render_segmentation
@@ -215,7 +214,7 @@ class MazeBatchEnv(batch.BatchEnv):
         self._geom_rgba = wp.to_torch(self._model.geom_rgba)
         self._geom_dataid = wp.to_torch(self._model.geom_dataid)
         self._cam_pos = wp.to_torch(self._model.cam_pos)  # per world with head-bob
-        self._camera = mujoco.mj_name2id(mjm, mujoco.mjtObj.mjOBJ_CAMERA, base.CAMERA)
+        self._camera = mujoco.mj_name2id(mjm, mujoco.mjtObj.mjOBJ_CAMERA, mjcf.EGO_CAMERA)
         self._rgb_packed = wp.to_torch(self._render.rgb_data)
         self._stream = wp.stream_from_torch(torch.cuda.current_stream(dev)) if dev.type == "cuda" else None
 
@@ -223,7 +222,7 @@ class MazeBatchEnv(batch.BatchEnv):
         self._episodes = torch.zeros(n, dtype=torch.int64, device=dev)
         self._config_index = torch.zeros(n, dtype=torch.int64, device=dev)
         self._ended = torch.zeros(n, dtype=torch.bool, device=dev)
-        self._path = torch.zeros((n, base.TICS_PER_STEP, 2), dtype=torch.float64, device=dev)
+        self._path = torch.zeros((n, core.TICS_PER_STEP, 2), dtype=torch.float64, device=dev)
         self._turn_held = torch.zeros(n, dtype=torch.float64, device=dev)  # tics a turn key has been held
         self._bob = torch.zeros(n, dtype=torch.float64, device=dev)  # Doom's walking bob of the last tic
         self._obs = torch.zeros((n, height, width, 3), dtype=torch.uint8, device=dev)
@@ -298,10 +297,10 @@ class MazeBatchEnv(batch.BatchEnv):
         return wp.ScopedStream(self._stream)
 
     def _advance_physics(self, forward: torch.Tensor, turn: torch.Tensor) -> None:
-        """The step's tics with Doom's motion and speculative contacts, as :meth:`mjmaze.tasks.base.MazePhysics.step`."""
+        """The step's tics with Doom's motion and speculative contacts, as :meth:`mjmaze.physics.MazePhysics.step`."""
         qpos, qvel, dt = self._qpos, self._qvel, self._timestep
-        for tic in range(base.TICS_PER_STEP):
-            vx, vy, yaw_rate, self._turn_held = base.tic_motion(
+        for tic in range(core.TICS_PER_STEP):
+            vx, vy, yaw_rate, self._turn_held = physics.tic_motion(
                 self.xp, qvel[:, 0].double(), qvel[:, 1].double(), qpos[:, 2].double(), forward, turn, self._turn_held, dt
             )
             qvel[:, 0], qvel[:, 1], qvel[:, 2] = vx, vy, yaw_rate
@@ -309,7 +308,7 @@ class MazeBatchEnv(batch.BatchEnv):
             qpos[:, :2] += ahead
             mjw.step(self._model, self._data)
             qpos[:, :2] -= ahead
-            qvel[:, :2] *= base.FRICTION
+            qvel[:, :2] *= physics.FRICTION
             self._path[:, tic] = qpos[:, :2]
         self._bob = look.walking_bob(self.xp, vx, vy, dt)
 
@@ -319,7 +318,7 @@ class MazeBatchEnv(batch.BatchEnv):
         Every env's start is worked out and kept only where ``restart`` is set:
         a fixed-size batch, so no count or index list comes back from the
         device. Except where a scenario's start is costly
-        (:attr:`mjmaze.tasks.base.MazeTask.costly_start`: Two-colour draws 20
+        (:attr:`mjmaze.core.MazeRules.costly_start`: Two-colour draws 20
         items against every wall), which is worked out for the restarting envs
         alone, at the cost of one wait for the device to say which they are.
         """
@@ -388,7 +387,7 @@ class MazeBatchEnv(batch.BatchEnv):
         m, d, rc = self._model, self._data, self._render
         task = self.task
         if task.head_bob:
-            eye_dz, pistol_dx, pistol_dy = look.view_bob(self.xp, self._bob, self.state["steps"] * base.TICS_PER_STEP)
+            eye_dz, pistol_dx, pistol_dy = look.view_bob(self.xp, self._bob, self.state["steps"] * core.TICS_PER_STEP)
             self._cam_pos[:, self._camera, 2] = (mjcf.EYE_HEIGHT + eye_dz).float()
         mjw.kinematics(m, d)  # positions lag a step behind mjw.step's integration
         mjw.camlight(m, d)
@@ -418,7 +417,7 @@ class MazeBatchEnv(batch.BatchEnv):
         task, state = self.task, self.state
         qpos = self._qpos.double()
         yaw = qpos[:, 2] - math.tau * torch.round(qpos[:, 2] / math.tau)
-        fields = base.episode_info(task.episode_metrics(state), qpos[:, 0], qpos[:, 1], yaw, state["steps"],
+        fields = core.episode_info(task.episode_metrics(state), qpos[:, 0], qpos[:, 1], yaw, state["steps"],
                                    state["episode_return"], self._config_index)
         if mask is None:
             mask = torch.ones(self.num_envs, dtype=torch.bool, device=self.device)

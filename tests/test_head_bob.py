@@ -37,7 +37,8 @@ def open_room(head_bob=None, width=320, height=180):
     """A 10 m room without inner walls or items, the agent at its south end facing north, clear of the totem."""
     bob = {} if head_bob is None else {"head_bob": head_bob}  # None: the default
     # ViZDoom's probe room had the pistol and no damaging floor: no flashes, the pistol drawn.
-    task = two_colour.TwoColour(complexity=0, item_cap=0, width=width, height=height, random=0, flashes=False, **bob)
+    task = base.task_class(two_colour.TwoColour)(complexity=0, item_cap=0, width=width, height=height, random=0,
+                                                 flashes=False, **bob)
     task.pistol = True
     env = base.make_environment(task)
     env.reset()

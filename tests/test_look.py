@@ -20,7 +20,7 @@ CLOSE = 9
 
 def empty_room(room: mjcf.Room):
     """A 10 m arena without walls inside (Two-colour at complexity 0) coloured as ``room``, objects hidden."""
-    task = two_colour.TwoColour(complexity=0, item_cap=0, random=0)
+    task = base.task_class(two_colour.TwoColour)(complexity=0, item_cap=0, random=0)
     task.room = room
     env = base.make_environment(task)
     env.reset()

@@ -255,7 +255,7 @@ def empty_arena(room: str, pistol: bool = True):
     """An empty 10 m arena (Two-colour at complexity 0) coloured as ``room``, its objects hidden."""
     from mjmaze import mjcf
 
-    task = two_colour.TwoColour(complexity=0, item_cap=0, flashes=False)
+    task = base.task_class(two_colour.TwoColour)(complexity=0, item_cap=0, flashes=False)
     task.room = {"stone": mjcf.STONE_ROOM, "slime": mjcf.SLIME_ROOM}[room]
     task.pistol = pistol  # as the ViZDoom probe beside it (released_game's weapon)
     env = base.make_environment(task)

@@ -25,8 +25,8 @@ Version History
 
 from __future__ import annotations
 
-from mjmaze import configs, maze, mjcf, registry, rules
-from mjmaze.tasks import base
+from mjmaze import configs, core, maze, mjcf, registry, rules
+
 
 SIZES = (5, 7, 9, 11, 13)
 PAPER_SIZES = (7, 9, 11, 13)
@@ -34,11 +34,11 @@ DEFAULT_SIZE = 9
 CELL_SIZE = 1.0
 TARGET_REWARD = 0.5
 RETURN_REWARD = 0.5
-STEP_REWARD = -0.0001 * base.TICS_PER_STEP
+STEP_REWARD = -0.0001 * core.TICS_PER_STEP
 # Doom's tall green and red columns (things 30 and 32), as released: 16 map
 # units in radius, 52 high.
-PILLAR_RADIUS = 16 * base.MAP_UNIT
-PILLAR_HEIGHT = 52 * base.MAP_UNIT
+PILLAR_RADIUS = 16 * mjcf.MAP_UNIT
+PILLAR_HEIGHT = 52 * mjcf.MAP_UNIT
 # The agent spawns this far off the green pillar in -x and -y.
 SPAWN_OFFSET = 0.25
 
@@ -52,14 +52,14 @@ RED_PILLAR = mjcf.ObjectGeom(
 )
 
 
-class FindReturn(base.MazeTask):
+class FindReturn(core.MazeRules):
     """Find the red pillar and return to the green one; see the module docstring."""
 
     scenario = "find_return"
     objects = (GREEN_PILLAR, RED_PILLAR)
 
     def __init__(self, size: int = DEFAULT_SIZE, **kwargs):
-        base._check_choice("size", size, SIZES)
+        core.check_choice("size", size, SIZES)
         # The spawn cell holds the green pillar; the one object is the red pillar.
         layout = configs.LayoutSpec(size, CELL_SIZE, maze.DEFAULT_KEEP_PROBABILITY, num_objects=1)
         super().__init__(difficulty=size, layout=layout, **kwargs)

@@ -30,8 +30,8 @@ Version History
 
 from __future__ import annotations
 
-from mjmaze import configs, maze, mjcf, registry, rules
-from mjmaze.tasks import base
+from mjmaze import configs, core, maze, mjcf, registry, rules
+
 
 NUM_ITEMS = tuple(range(1, 9))
 PAPER_NUM_ITEMS = (2, 4, 6, 8)
@@ -41,7 +41,7 @@ SIZES = tuple(range(2, 14))
 CELL_SIZE = 1.25
 NEXT_ITEM_REWARD = 0.5
 WRONG_ITEM_REWARD = -0.25
-STEP_REWARD = -0.0001 * base.TICS_PER_STEP
+STEP_REWARD = -0.0001 * core.TICS_PER_STEP
 
 
 # Item kinds in collection order: (colour code in the released files, geom).
@@ -67,14 +67,14 @@ KINDS = (
 KIND_OF_CODE = {code: kind for kind, (code, _) in enumerate(KINDS)}
 
 
-class KItem(base.MazeTask):
+class KItem(core.MazeRules):
     """Collect K items in the fixed order; see the module docstring."""
 
     scenario = "k_item"
 
     def __init__(self, num_items: int = DEFAULT_NUM_ITEMS, size: int = DEFAULT_SIZE, **kwargs):
-        base._check_choice("num_items", num_items, NUM_ITEMS)
-        base._check_choice("size", size, SIZES)
+        core.check_choice("num_items", num_items, NUM_ITEMS)
+        core.check_choice("size", size, SIZES)
         if num_items + 1 > size * size:
             raise ValueError(
                 f"num_items={num_items} needs {num_items + 1} distinct cells (the items and the spawn), "

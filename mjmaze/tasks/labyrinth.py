@@ -28,15 +28,15 @@ Version History
 
 from __future__ import annotations
 
-from mjmaze import configs, maze, mjcf, registry, rules
-from mjmaze.tasks import base
+from mjmaze import configs, core, maze, mjcf, registry, rules
+
 
 SIZES = (5, 7, 9, 11, 13)
 PAPER_SIZES = (7, 9, 11, 13)
 DEFAULT_SIZE = 9
 CELL_SIZE = 1.0
 EXIT_REWARD = 1.0
-STEP_REWARD = -0.0001 * base.TICS_PER_STEP
+STEP_REWARD = -0.0001 * core.TICS_PER_STEP
 
 # The released mazes' exit is Doom's green armour (thing 2018): a pickup lying
 # on the floor, 40 x 16 map units (a 31 x 17 sprite), i.e. 0.12 m in radius and
@@ -45,21 +45,21 @@ STEP_REWARD = -0.0001 * base.TICS_PER_STEP
 # Its mean colour is the armour's as ViZDoom draws it, blinking, at the
 # released light, a dull olive (docs/look.md); its side shows the sprite's
 # grey plates, vivid green chest and dark edge as bands around that mean.
-EXIT_RADIUS, EXIT_HEIGHT = 0.12, 16 * base.MAP_UNIT
+EXIT_RADIUS, EXIT_HEIGHT = 0.12, 16 * mjcf.MAP_UNIT
 EXIT = mjcf.ObjectGeom(
     "exit", "cylinder", (EXIT_RADIUS, EXIT_HEIGHT / 2), mjcf.GREEN_ARMOUR_RGBA, z=EXIT_HEIGHT / 2,
     bands=mjcf.GREEN_ARMOUR_BANDS,
 )
 
 
-class Labyrinth(base.MazeTask):
+class Labyrinth(core.MazeRules):
     """Find the exit; see the module docstring."""
 
     scenario = "labyrinth"
     objects = (EXIT,)
 
     def __init__(self, size: int = DEFAULT_SIZE, **kwargs):
-        base._check_choice("size", size, SIZES)
+        core.check_choice("size", size, SIZES)
         layout = configs.LayoutSpec(size, CELL_SIZE, maze.DEFAULT_KEEP_PROBABILITY, num_objects=1)
         super().__init__(difficulty=size, layout=layout, **kwargs)
 

@@ -44,8 +44,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from mjmaze import configs, mjcf, registry, rules
-from mjmaze.tasks import base
+from mjmaze import configs, core, mjcf, registry, rules
+
 
 COMPLEXITIES = tuple(range(0, 11))
 PAPER_COMPLEXITIES = (1, 3, 5, 7)
@@ -54,7 +54,7 @@ GRID_SIZE = 5
 CELL_SIZE = 2.0
 START_ITEMS_PER_COLOUR = 10
 SPAWN_EVERY_TICS = 30
-POOL_SIZE = 2 * START_ITEMS_PER_COLOUR + (base.EPISODE_STEPS * base.TICS_PER_STEP) // SPAWN_EVERY_TICS  # 90
+POOL_SIZE = 2 * START_ITEMS_PER_COLOUR + (core.EPISODE_STEPS * core.TICS_PER_STEP) // SPAWN_EVERY_TICS  # 90
 MAX_HEALTH = 100
 ITEM_HEALTH = 25
 # The released script hands over the armour first, then takes 25 with
@@ -74,11 +74,11 @@ LAVA_DAMAGE = 8
 LAVA_EVERY_TICS = 32
 LAVA_FIRST_TIC = 23
 START_HEALTH = MAX_HEALTH - LAVA_DAMAGE
-SURVIVAL_REWARD = 0.01 * base.TICS_PER_STEP
+SURVIVAL_REWARD = 0.01 * core.TICS_PER_STEP
 CORRECT_ITEM_REWARD = 1.0
 # Items appear uniformly where the agent can stand: at least its radius from
 # every wall, clear of the totem by both radii, and out of the agent's reach.
-ITEM_WALL_CLEARANCE = base.AGENT_RADIUS
+ITEM_WALL_CLEARANCE = core.AGENT_RADIUS
 # Points tried per item, the first free one kept (see TwoColour._free_positions):
 # a point lands on free floor with probability >= 0.79 (complexity 10, the
 # most walls, measured over generated mazes), so all 32 miss with probability
@@ -100,13 +100,13 @@ ITEM_RED, ITEM_GREEN = mjcf.RED_ARMOUR_RGBA, mjcf.GREEN_ARMOUR_RGBA
 TOTEM = mjcf.floor_thing("totem", "cylinder", 32, 52, RED, collides=True)
 TOTEM_RADIUS = TOTEM.size[0]
 # The agent's centre never comes closer to the totem's than this.
-TOTEM_CLEARANCE = TOTEM_RADIUS + base.AGENT_RADIUS
+TOTEM_CLEARANCE = TOTEM_RADIUS + core.AGENT_RADIUS
 ITEMS = tuple(mjcf.floor_thing(f"item_{k}", "cylinder", 31, 17, ITEM_RED) for k in range(POOL_SIZE))
 TOTEM_COLOURS = (tuple(RED), tuple(GREEN))  # by totem_green
 ITEM_COLOURS = tuple(tuple(ITEM_GREEN if k % 2 == 0 else ITEM_RED) for k in range(POOL_SIZE))
 
 
-class TwoColour(base.MazeTask):
+class TwoColour(core.MazeRules):
     """Pick up items of the totem's colour to stay alive; see the module docstring."""
 
     scenario = "two_colour"
@@ -122,7 +122,7 @@ class TwoColour(base.MazeTask):
         item_cap: int | None = None,
         **kwargs,
     ):
-        base._check_choice("complexity", complexity, COMPLEXITIES)
+        core.check_choice("complexity", complexity, COMPLEXITIES)
         if item_cap is not None and not 0 <= item_cap <= POOL_SIZE:
             raise ValueError(f"item_cap must be None (no cap) or in 0..{POOL_SIZE}, got {item_cap!r}")
         layout = configs.LayoutSpec(GRID_SIZE, CELL_SIZE, complexity / 10, num_objects=1, centre_object=True)
@@ -187,7 +187,7 @@ class TwoColour(base.MazeTask):
         # The step's events, in the order Doom takes them: by tic, and within a
         # tic the floor's hit before the items (by index). Health is capped,
         # so the order matters. Event 0 is the lava, event 1 + k item k.
-        before = (state["steps"] - 1) * base.TICS_PER_STEP  # tics played before this step
+        before = (state["steps"] - 1) * core.TICS_PER_STEP  # tics played before this step
         lava_tic = (LAVA_FIRST_TIC - 1 - before) % LAVA_EVERY_TICS  # this step's tic index of the next hit
         event_tic = xp.concat([xp.where(lava_tic < tics, lava_tic, -1)[:, None], first_tic], axis=1)
         index = xp.arange(1 + POOL_SIZE, dtype=xp.int64, device=device)
@@ -227,7 +227,7 @@ class TwoColour(base.MazeTask):
         collides = state["object_collides"]
         state["object_collides"] = xp.concat([collides[:, :1] | (clear & ~dead)[:, None], collides[:, 1:]], axis=1)
         # One item every 30 tics (never more than one per 4-tic step after the start).
-        due = rules.at_most(xp, 2 * START_ITEMS_PER_COLOUR + state["steps"] * base.TICS_PER_STEP // SPAWN_EVERY_TICS, self._item_cap)
+        due = rules.at_most(xp, 2 * START_ITEMS_PER_COLOUR + state["steps"] * core.TICS_PER_STEP // SPAWN_EVERY_TICS, self._item_cap)
         spawn = ~dead & (state["items_spawned"] < due)
         # On numpy most steps spawn nothing: skip the draws then. On torch, draw
         # for every env and keep the spawns (asking whether any is due would wait for the GPU).
@@ -268,7 +268,7 @@ class TwoColour(base.MazeTask):
             free = (
                 (xp.min(gap_x * gap_x + gap_y * gap_y, axis=-1) >= ITEM_WALL_CLEARANCE**2)
                 & (xp.sum((points - totem_xy) ** 2, axis=-1) >= TOTEM_CLEARANCE**2)
-                & (xp.sum((points - agent_xy[:, None, None, :]) ** 2, axis=-1) >= base.PICKUP_RADIUS**2)
+                & (xp.sum((points - agent_xy[:, None, None, :]) ** 2, axis=-1) >= core.PICKUP_RADIUS**2)
             )
             first = candidate[..., 0] == xp.argmax(xp.astype(free, xp.int8), axis=-1)[..., None]  # (B, k, candidates)
             xys.append(xp.sum(points * xp.astype(first, xp.float64)[..., None], axis=2))
@@ -277,7 +277,7 @@ class TwoColour(base.MazeTask):
 
     def episode_metrics(self, state):
         return {
-            "duration": state["steps"] * base.TICS_PER_STEP,
+            "duration": state["steps"] * core.TICS_PER_STEP,
             "health": state["health"],
             "totem_green": state["totem_green"],
         }

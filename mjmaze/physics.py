@@ -1,0 +1,163 @@
+"""Doom's player motion and the CPU physics of a maze arena.
+
+One physics step is one Doom tic. :func:`tic_motion` is Doom's movement of a
+tic (the velocity from the held keys and the momentum), written once for the
+CPU physics here (floats) and the MuJoCo Warp backend (tensors of every
+world); :class:`MazePhysics` steps a dm_control physics tic by tic with
+speculative contacts (docs/motion.md).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import mujoco as mj
+import numpy as np
+from dm_control import mujoco
+
+from mjmaze import core, look, mjcf, render
+
+TICS_PER_STEP = core.TICS_PER_STEP
+# Motion: Doom's player movement, tic by tic (ZDoom's P_MovePlayer and
+# P_XYMovement; measured in ViZDoom, see docs/motion.md). A held forward key
+# adds a walking thrust to the velocity each tic and friction keeps 0.90625 of
+# it after the tic's move, so the agent gathers speed over ~3 agent steps and
+# coasts after letting go; a turn key turns 3.52 degrees a tic, half that for
+# the first 5 tics it is held.
+MAP_UNIT = mjcf.MAP_UNIT  # metres
+THRUST_PER_TIC = 25 * 2048 / 65536 * MAP_UNIT  # m/tic gained per tic: forwardmove 0x19 (walking)
+FRICTION = 0xE800 / 0x10000  # share of the velocity a tic keeps
+TURN_PER_TIC = math.tau * 640 / 65536  # radians: angleturn 640 of a 65536 turn
+SLOW_TURN_TICS = 5  # a turn key's first tics turn at half rate (ZDoom's SLOWTURNTICS)
+# At full speed in open space: 0.261 m and 14.06 degrees per agent step.
+FORWARD_PER_STEP = TICS_PER_STEP * THRUST_PER_TIC / (1 - FRICTION)
+TURN_PER_STEP = TICS_PER_STEP * TURN_PER_TIC
+#: The geom group of an object the agent sees (a hidden one is in render.HIDDEN_GROUP).
+VISIBLE_GROUP = 1
+
+
+class MazePhysics(mujoco.Physics):
+    """Physics of a maze arena, with named accessors for the agent.
+
+    :meth:`step` advances tic by tic with speculative contacts and keeps the
+    agent's floor position after every tic in :attr:`tic_xy`, for pick-ups
+    tested every tic as Doom does.
+    """
+
+    #: ``(tics, 2)``: the agent's ``(x, y)`` after each tic of the last :meth:`step`.
+    tic_xy: np.ndarray = np.zeros((0, 2))
+    #: The keys held during the next :meth:`step`: ``(forward, turn)``, each -1, 0 or 1.
+    command: tuple[int, int] = (0, 0)
+    #: Tics a turn key has been held without a break (Doom's slow start of a turn).
+    turn_held: int = 0
+    #: Doom's walking bob (map units) of the last tic: see :func:`mjmaze.look.view_bob`.
+    bob: float = 0.0
+
+    def step(self, nstep: int = 1) -> None:
+        """Advances ``nstep`` tics of :attr:`command`; walls and pillars stop the agent at its radius.
+
+        Each tic moves the agent as Doom does (:func:`tic_motion`, then
+        friction). Collisions are found where the agent will be at the end of
+        the tic (positions moved ahead by ``qvel * dt`` for ``mj_step``, then
+        moved back), and the arena's contacts (see ``xml_templates/arena.xml``)
+        take exactly the predicted penetration out of the velocity, so momentum
+        into a wall is lost and the rest slides along it. Plain ``mj_step``
+        finds a contact only after the agent has sunk up to a tic's travel
+        (6 cm) into a wall, then pushes it back: a 6 cm jitter against every wall.
+        """
+        model, data = self.model.ptr, self.data.ptr
+        qpos, qvel, dt = data.qpos, data.qvel, model.opt.timestep
+        forward, turn = self.command
+        if len(self.tic_xy) != nstep:
+            self.tic_xy = np.zeros((nstep, 2))
+        tic_xy = self.tic_xy
+        # Plain floats and math between the tics: numpy's per-call cost on
+        # 1-element reads and writes is a fair part of a tic here.
+        vx, vy, held = float(qvel[0]), float(qvel[1]), self.turn_held
+        with self.check_invalid_state():
+            for tic in range(nstep):
+                vx, vy, yaw_rate, held = tic_motion(math, vx, vy, float(qpos[2]), forward, turn, held, dt)
+                qvel[0], qvel[1], qvel[2] = vx, vy, yaw_rate
+                thrust_vx, thrust_vy = vx, vy  # Doom's bob reads the velocity here
+                # Only x and y matter (the agent is a sphere).
+                ahead_x, ahead_y = vx * dt, vy * dt
+                qpos[0] += ahead_x
+                qpos[1] += ahead_y
+                mj.mj_step(model, data)
+                qpos[0] -= ahead_x
+                qpos[1] -= ahead_y
+                # The contacts took away the velocity into walls; friction keeps a share of the rest.
+                vx, vy = float(qvel[0]) * FRICTION, float(qvel[1]) * FRICTION
+                tic_xy[tic] = qpos[:2]
+        qvel[0], qvel[1] = vx, vy
+        self.turn_held = held
+        if nstep:
+            self.bob = float(look.walking_bob(np, thrust_vx, thrust_vy, dt))
+
+    def agent_pose(self) -> tuple[float, float, float]:
+        """``(x, y, yaw)`` of the agent; yaw in radians in ``(-pi, pi]``, 0 facing +x."""
+        x, y, yaw = self.data.qpos[:3]
+        return float(x), float(y), float(math.remainder(yaw, math.tau))
+
+    def set_agent_pose(self, x: float, y: float, yaw: float) -> None:
+        self.data.qpos[:3] = (x, y, yaw)
+        self.data.qvel[:3] = 0.0
+        self.turn_held = 0
+        self.bob = 0.0
+
+    def object_ids(self, names: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
+        """``(ids for place_objects, geom ids)`` of scenario objects (see :class:`mjmaze.mjcf.ObjectGeom`).
+
+        Both are the objects' geom ids (the pair keeps scenario code unchanged).
+        Looked up once per list of names (Two-colour asks for 91 at every reset).
+        """
+        key = tuple(names)
+        cache = self.__dict__.setdefault("_object_ids", {})
+        if key not in cache:
+            model = self.model.ptr
+            cache[key] = np.array([mj.mj_name2id(model, mj.mjtObj.mjOBJ_GEOM, name) for name in names], dtype=int)
+        geom_ids = cache[key]
+        return geom_ids.copy(), geom_ids.copy()
+
+    def place_objects(self, object_ids, xy) -> None:
+        """Moves objects (ids from :meth:`object_ids`) to floor positions ``xy`` (shape ``(n, 2)`` or ``(2,)``).
+
+        An object in a mocap body (one that collides) moves by ``data.mocap_pos``,
+        any other by its geom's position in the model.
+        """
+        model = self.model.ptr
+        ids = np.atleast_1d(object_ids)
+        xy = np.broadcast_to(np.asarray(xy, dtype=float).reshape(-1, 2), (len(ids), 2))
+        mocap = model.body_mocapid[model.geom_bodyid[ids]]
+        in_body = mocap >= 0
+        self.data.ptr.mocap_pos[mocap[in_body], :2] = xy[in_body]
+        model.geom_pos[ids[~in_body], :2] = xy[~in_body]
+
+    def show_objects(self, geom_ids, visible) -> None:
+        """Shows (True) or hides (False) objects in the agent's view."""
+        self.model.ptr.geom_group[geom_ids] = np.where(visible, VISIBLE_GROUP, render.HIDDEN_GROUP)
+
+    def set_object_collisions(self, geom_id: int, collides: bool) -> None:
+        """Makes an object that collides (a pillar, the totem) block the agent or not."""
+        self.model.ptr.geom_contype[geom_id] = self.model.ptr.geom_conaffinity[geom_id] = int(collides)
+
+    def set_object_rgba(self, geom_id: int, rgba) -> None:
+        self.model.ptr.geom_rgba[geom_id] = rgba
+
+
+def tic_motion(xp, vx, vy, yaw, forward, turn, turn_held, timestep: float):
+    """One tic of Doom's player movement: ``(vx, vy, yaw rate, turn_held)`` to move with this tic.
+
+    ``forward`` and ``turn`` (+1 left) are the held keys (-1, 0, 1),
+    ``turn_held`` the tics a turn key was held before this one. Doom turns the
+    player, then thrusts along the new heading; friction (:data:`FRICTION`)
+    follows the tic's move (the caller applies it, after contacts). Works on
+    floats (``xp = math``) and on arrays (``xp`` an array namespace), so the
+    CPU task and the Warp backend move the agent by the same statement.
+    """
+    turn_held = (turn_held + 1) * (turn != 0)
+    yaw_rate = turn * TURN_PER_TIC * (1.0 - 0.5 * (turn_held <= SLOW_TURN_TICS)) / timestep
+    heading = yaw + yaw_rate * timestep
+    thrust = forward * THRUST_PER_TIC / timestep
+    return vx + thrust * xp.cos(heading), vy + thrust * xp.sin(heading), yaw_rate, turn_held
