@@ -92,6 +92,9 @@ WALL_THICKNESS = 0.125
 WALL_HEIGHT = 1.0
 WALL_MESH = "walls"
 EGO_CAMERA = "ego"  # the agent's eye (xml_templates/arena.xml)
+VISIBLE_GROUP = 1  # the geom group of an object the agent sees (mjmaze.render.HIDDEN_GROUP: one it does not)
+ARENA_BODY = "arena"  # build_xml's batch arena: the body holding what differs between worlds
+COLLISION_SUFFIX = "_collision"  # build_xml's batch arena: a colliding object's blocking twin
 OVERHEAD_CAMERA = "overhead"
 OVERHEAD_HEIGHT = 10.0
 LAMP = "lamp"
@@ -195,12 +198,21 @@ def overhead_extent(grid_size: int, cell_size: float) -> float:
 
 def build_xml(
     grid_size: int, cell_size: float, objects: Sequence[ObjectGeom] = (), visual_style: str = "textured",
-    room: Room = STONE_ROOM,
+    room: Room = STONE_ROOM, wall_layout_quads: Sequence[int] | None = None,
 ) -> str:
     """The MJCF of an arena for ``grid_size x grid_size`` cells of ``cell_size`` metres, coloured as ``room``.
 
     A ``"textured"`` model needs :func:`paint_textures` after compiling.
+
+    ``wall_layout_quads``: the arena for MuJoCo Warp's batch of worlds, a maze
+    per world (:mod:`mjmaze.warp`; docs/warp_backend.md): one wall mesh per
+    distinct wall layout, ``walls_0``, ``walls_1``, ... with room for that many
+    quads each; every wall box, the wall mesh and every object in one mocap
+    body (:data:`ARENA_BODY`) at the origin, objects drawn (hidden ones are
+    moved away per world); an object that collides drawn by a geom that does
+    not and blocked by an undrawn twin that does (``<name>_collision``).
     """
+    batch = wall_layout_quads is not None
     if visual_style not in VISUAL_STYLES:
         raise ValueError(f"visual_style must be one of {VISUAL_STYLES}, got {visual_style!r}")
     root = ET.fromstring(template_path().read_text())
@@ -219,11 +231,18 @@ def build_xml(
         _add_textures(root)
     segments = wall_segments(grid_size, cell_size)
 
-    # A placeholder mesh with room for the most quads any maze needs (every
-    # segment cut into pieces, all five quads each); WallLayout.apply overwrites
-    # it before first use.
-    add_placeholder_mesh(asset, WALL_MESH, len(segments) * _pieces_per_segment(cell_size) * _BOX_QUADS)
-    ET.SubElement(worldbody, "geom", name="walls_visual", type="mesh", mesh=WALL_MESH, material="wall")
+    if batch:
+        arena = ET.SubElement(worldbody, "body", name=ARENA_BODY, mocap="true", pos="0 0 0")
+        for layout, quads in enumerate(wall_layout_quads):  # overwritten after compiling (write_wall_mesh)
+            add_placeholder_mesh(asset, f"{WALL_MESH}_{layout}", quads)
+        ET.SubElement(arena, "geom", name="walls_visual", type="mesh", mesh=f"{WALL_MESH}_0", material="wall")
+    else:
+        arena = worldbody
+        # A placeholder mesh with room for the most quads any maze needs (every
+        # segment cut into pieces, all five quads each); WallLayout.apply overwrites
+        # it before first use.
+        add_placeholder_mesh(asset, WALL_MESH, len(segments) * _pieces_per_segment(cell_size) * _BOX_QUADS)
+        ET.SubElement(worldbody, "geom", name="walls_visual", type="mesh", mesh=WALL_MESH, material="wall")
     # The floor after the walls: MuJoCo draws geoms in model order, so floor
     # pixels hidden by walls fail the depth test before any shading.
     half_extent = grid_size * cell_size / 2 + WALL_THICKNESS
@@ -247,11 +266,12 @@ def build_xml(
     )
     for k, (x, y, hx, hy) in enumerate(segments):
         ET.SubElement(
-            worldbody, "geom", name=f"wall_{k}", **{"class": "wall_collision"},
+            arena, "geom", name=f"wall_{k}", **{"class": "wall_collision"},
             # Compiled in place: MuJoCo's midphase keeps the world body's
             # geom bounding boxes from compile time, so boxes never move.
             size=f"{hx} {hy} {WALL_HEIGHT / 2}", pos=f"{x} {y} {WALL_HEIGHT / 2}",
         )
+    colliding = []  # batch: the colliding objects' attributes, placed last
     for obj in objects:  # see ObjectGeom
         rgba = obj.rgba
         attrs = dict(name=obj.name, type=obj.type, size=" ".join(map(str, obj.size)))
@@ -265,11 +285,18 @@ def build_xml(
             attrs["material"] = obj.name
             rgba = (*np.minimum(np.array(obj.rgba[:3]) * gain, 1.0).round(4).tolist(), obj.rgba[3])
         attrs["rgba"] = " ".join(map(str, rgba))
-        if obj.collides:
+        if batch:
+            colliding.append(attrs) if obj.collides else ET.SubElement(
+                arena, "geom", **{"class": "item"}, pos=f"0 0 {obj.z}", group=str(VISIBLE_GROUP), **attrs)
+        elif obj.collides:
             body = ET.SubElement(worldbody, "body", name=obj.name, mocap="true", pos=f"0 0 {obj.z}")
             ET.SubElement(body, "geom", **{"class": "item"}, contype="1", conaffinity="1", **attrs)
         else:
             ET.SubElement(worldbody, "geom", **{"class": "item"}, pos=f"0 0 {obj.z}", **attrs)
+    for attrs, obj in zip(colliding, [obj for obj in objects if obj.collides]):  # batch: after the others
+        ET.SubElement(arena, "geom", **{"class": "item"}, pos=f"0 0 {obj.z}", group=str(VISIBLE_GROUP), **attrs)
+        ET.SubElement(arena, "geom", **{"class": "item"}, pos=f"0 0 {obj.z}", **{
+            **attrs, "name": obj.name + COLLISION_SUFFIX, "group": "3", "contype": "1", "conaffinity": "1"})
     return ET.tostring(root, encoding="unicode")
 
 

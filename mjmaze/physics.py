@@ -33,8 +33,7 @@ SLOW_TURN_TICS = 5  # a turn key's first tics turn at half rate (ZDoom's SLOWTUR
 # At full speed in open space: 0.261 m and 14.06 degrees per agent step.
 FORWARD_PER_STEP = TICS_PER_STEP * THRUST_PER_TIC / (1 - FRICTION)
 TURN_PER_STEP = TICS_PER_STEP * TURN_PER_TIC
-#: The geom group of an object the agent sees (a hidden one is in render.HIDDEN_GROUP).
-VISIBLE_GROUP = 1
+VISIBLE_GROUP = mjcf.VISIBLE_GROUP
 
 
 class MazePhysics(mujoco.Physics):

@@ -34,7 +34,6 @@ imports Warp or torch, only this module does.
 from __future__ import annotations
 
 import math
-import xml.etree.ElementTree as ET
 from typing import Any
 
 import mujoco
@@ -51,58 +50,27 @@ _AWAY_Z = -50.0
 # Contacts and constraint rows a world can hold: the agent (a sphere) touches
 # at most a corner's few wall boxes and a pillar at once.
 _CONTACTS_PER_WORLD = 16
-_ARENA_BODY = "arena"
-_COLLISION_SUFFIX = "_collision"
 
 
 def build_model(task: core.MazeRules) -> tuple[mujoco.MjModel, np.ndarray, np.ndarray]:
-    """The task's arena as one MuJoCo model for all worlds, with a wall mesh per layout.
+    """The task's arena as one MuJoCo model for all worlds, with a wall mesh per layout (:func:`mjmaze.mjcf.build_xml`).
 
     Returns ``(model, mesh_of_config (C,), box_z_of_config (C, boxes))``: which
     mesh draws configuration ``c``'s walls and where its wall boxes stand (an
     absent wall's box below the floor).
     """
     layout = task.layout
-    root = ET.fromstring(mjcf.build_xml(layout.grid_size, layout.cell_size, task.objects, task.visual_style, task.room))
-    worldbody, asset = root.find("worldbody"), root.find("asset")
-    arena = ET.SubElement(worldbody, "body", name=_ARENA_BODY, mocap="true", pos="0 0 0")
     # One mesh per distinct wall layout among the task's configurations.
     all_configs = [task.configs[i] for i in range(len(task.configs))]
     layouts: dict[bytes, int] = {}
     mesh_of_config = np.array([layouts.setdefault(c.layout_key(), len(layouts)) for c in all_configs], dtype=np.int32)
-    first_of_layout = {}
+    first_of_layout: dict[int, object] = {}
     for config, mesh in zip(all_configs, mesh_of_config):
         first_of_layout.setdefault(int(mesh), config)
-    asset.remove(asset.find(f"mesh[@name='{mjcf.WALL_MESH}']"))
-    for mesh, config in first_of_layout.items():
-        quads = mjcf.wall_mesh_quads(config.h_walls, config.v_walls, layout.cell_size)
-        mjcf.add_placeholder_mesh(asset, f"{mjcf.WALL_MESH}_{mesh}", quads)
-    for geom in list(worldbody.findall("geom")):
-        name = geom.get("name", "")
-        if name == "walls_visual":
-            geom.set("mesh", f"{mjcf.WALL_MESH}_0")
-        elif name in ("floor", "ceiling"):  # the geoms that stay in the world body
-            continue
-        worldbody.remove(geom)
-        arena.append(geom)
-    for obj in task.objects:  # every object in the arena body, drawn; hidden = moved away
-        body = worldbody.find(f"body[@name='{obj.name}']")
-        if body is not None:  # a colliding object's own mocap body
-            worldbody.remove(body)
-            geom = body.find("geom")
-            geom.set("pos", f"0 0 {obj.z}")
-            arena.append(geom)
-        geom = arena.find(f"geom[@name='{obj.name}']")
-        geom.set("group", str(physics.VISIBLE_GROUP))
-        if obj.collides:
-            geom.set("contype", "0")
-            geom.set("conaffinity", "0")
-            twin = ET.SubElement(arena, "geom", dict(geom.attrib))
-            twin.set("name", obj.name + _COLLISION_SUFFIX)
-            twin.set("group", "3")
-            twin.set("contype", "1")
-            twin.set("conaffinity", "1")
-    model = mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
+    quads = [mjcf.wall_mesh_quads(c.h_walls, c.v_walls, layout.cell_size) for c in first_of_layout.values()]
+    xml = mjcf.build_xml(layout.grid_size, layout.cell_size, task.objects, task.visual_style, task.room,
+                         wall_layout_quads=quads)
+    model = mujoco.MjModel.from_xml_string(xml)
     mjcf.paint_textures(model, task.objects)
     for mesh, config in first_of_layout.items():
         mesh_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MESH, f"{mjcf.WALL_MESH}_{mesh}")
@@ -190,7 +158,7 @@ class MazeBatchEnv(batch.BatchEnv):
         colliding = [k for k, obj in enumerate(task.objects) if obj.collides]
         self._colliding = torch.tensor(colliding, dtype=torch.long, device=dev)
         self._collision_ids = torch.tensor(
-            [geom(task.objects[k].name + _COLLISION_SUFFIX) for k in colliding], dtype=torch.long, device=dev
+            [geom(task.objects[k].name + mjcf.COLLISION_SUFFIX) for k in colliding], dtype=torch.long, device=dev
         )
         self._timestep = float(mjm.opt.timestep)
         self._actions = torch.tensor(task.actions, dtype=torch.float64, device=dev)  # (A, 2): forward, turn

@@ -14,7 +14,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import mjmaze
-from mjmaze import configs, maze, mjcf, registry, rules, suite
+from mjmaze import configs, core, maze, mjcf, registry, rules, suite
 from mjmaze.tasks import base
 
 # -- a fifth scenario, stated once, here ---------------------------------------------
@@ -22,14 +22,14 @@ from mjmaze.tasks import base
 GOAL = mjcf.ObjectGeom("goal", "sphere", (0.15,), (1.0, 0.9, 0.0, 1.0), 0.3)
 
 
-class Beacon(base.MazeTask):
+class Beacon(core.MazeRules):
     """Reach the yellow beacon of a small maze: +1, and the episode ends."""
 
     scenario = "beacon"
     objects = (GOAL,)
 
     def __init__(self, size: int = 3, **kwargs):
-        base._check_choice("size", size, (3, 4))
+        core.check_choice("size", size, (3, 4))
         layout = configs.LayoutSpec(size, 1.0, maze.DEFAULT_KEEP_PROBABILITY, num_objects=1)
         super().__init__(difficulty=size, layout=layout, **kwargs)
 
