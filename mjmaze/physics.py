@@ -145,6 +145,32 @@ class MazePhysics(mujoco.Physics):
         self.model.ptr.geom_rgba[geom_id] = rgba
 
 
+def batch_tics(xp, qpos, qvel, forward, turn, turn_held, timestep: float, path, step_contacts) -> tuple:
+    """:meth:`MazePhysics.step` for a batch of worlds (the MuJoCo Warp backend): ``path.shape[1]`` tics.
+
+    ``qpos``, ``qvel`` ``(B, n)`` (x, y, yaw first; written in place),
+    ``forward``, ``turn`` and ``turn_held`` ``(B,)``; ``step_contacts()``
+    advances every world one tic (``mujoco_warp.step``); ``path`` ``(B, tics,
+    2)`` receives each tic's ``(x, y)``. The same arithmetic as
+    :meth:`MazePhysics.step`, which runs it on floats for one env (numpy's
+    per-call cost on 1-element arrays would double it there): tests/test_warp.py
+    holds the two to the same poses. Returns ``(turn_held, bob)``.
+    """
+    for tic in range(path.shape[1]):
+        vx, vy, yaw_rate, turn_held = tic_motion(
+            xp, xp.astype(qvel[:, 0], xp.float64), xp.astype(qvel[:, 1], xp.float64),
+            xp.astype(qpos[:, 2], xp.float64), forward, turn, turn_held, timestep,
+        )
+        qvel[:, 0], qvel[:, 1], qvel[:, 2] = vx, vy, yaw_rate
+        ahead = qvel[:, :2] * timestep
+        qpos[:, :2] += ahead
+        step_contacts()
+        qpos[:, :2] -= ahead
+        qvel[:, :2] *= FRICTION
+        path[:, tic] = qpos[:, :2]
+    return turn_held, look.walking_bob(xp, vx, vy, timestep)
+
+
 def tic_motion(xp, vx, vy, yaw, forward, turn, turn_held, timestep: float):
     """One tic of Doom's player movement: ``(vx, vy, yaw rate, turn_held)`` to move with this tic.
 

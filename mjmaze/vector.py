@@ -136,6 +136,7 @@ class _EnvGroup:
             for row, task in enumerate(tasks):
                 task.share_state(self._state, row)
             self._paths = np.zeros((len(tasks), base.TICS_PER_STEP, 2))
+            self._rules = tasks[0]  # every env's task is the same scenario core (mjmaze.core.MazeRules)
 
     def _restart(self, i: int, slot: int, env) -> None:
         env.reset()  # renders the first frame into the env's slot
@@ -156,7 +157,7 @@ class _EnvGroup:
         # The rules for every env of the group at once. An env about to restart
         # (its episode ended on the last step) goes through them too, on its
         # old state, which its restart then replaces.
-        rewards, terminated, truncated = envs[0][2].step_state(np, self._state, paths)
+        rewards, terminated, truncated = self._rules.step_state(np, self._state, paths)
         for i, (slot, env, task, physics) in enumerate(envs):
             if self._ended[i]:  # the step after an episode's end: its action is ignored
                 self._restart(i, slot, env)

@@ -265,20 +265,11 @@ class MazeBatchEnv(batch.BatchEnv):
         return wp.ScopedStream(self._stream)
 
     def _advance_physics(self, forward: torch.Tensor, turn: torch.Tensor) -> None:
-        """The step's tics with Doom's motion and speculative contacts, as :meth:`mjmaze.physics.MazePhysics.step`."""
-        qpos, qvel, dt = self._qpos, self._qvel, self._timestep
-        for tic in range(core.TICS_PER_STEP):
-            vx, vy, yaw_rate, self._turn_held = physics.tic_motion(
-                self.xp, qvel[:, 0].double(), qvel[:, 1].double(), qpos[:, 2].double(), forward, turn, self._turn_held, dt
-            )
-            qvel[:, 0], qvel[:, 1], qvel[:, 2] = vx, vy, yaw_rate
-            ahead = qvel[:, :2] * dt
-            qpos[:, :2] += ahead
-            mjw.step(self._model, self._data)
-            qpos[:, :2] -= ahead
-            qvel[:, :2] *= physics.FRICTION
-            self._path[:, tic] = qpos[:, :2]
-        self._bob = look.walking_bob(self.xp, vx, vy, dt)
+        """The step's tics with Doom's motion and speculative contacts (:func:`mjmaze.physics.batch_tics`)."""
+        self._turn_held, self._bob = physics.batch_tics(
+            self.xp, self._qpos, self._qvel, forward, turn, self._turn_held, self._timestep, self._path,
+            step_contacts=lambda: mjw.step(self._model, self._data),
+        )
 
     def _start_episodes(self, restart: torch.Tensor) -> None:
         """New episodes where ``restart`` ``(N,)`` is set: configuration, the scenario's start, the arena.

@@ -40,6 +40,8 @@ def _paths(state, step: int, xp) -> np.ndarray:
     return paths
 
 
+# Dynamo notes that it traces through array-api-compat's lru_cache'd type checks: harmless here.
+@pytest.mark.filterwarnings("ignore:Dynamo detected a call to a `functools.lru_cache`")
 @pytest.mark.slow
 @pytest.mark.parametrize("scenario", list(SETTINGS))
 def test_rules_compile_whole_and_match_numpy(scenario):
@@ -72,6 +74,7 @@ def _assert_same(on_numpy: dict, on_torch: dict, when: str) -> None:
         np.testing.assert_array_equal(value, on_torch[name].numpy(), err_msg=f"{name} after {when}")
 
 
+@pytest.mark.filterwarnings("ignore:Dynamo detected a call to a `functools.lru_cache`")
 def test_flash_compiles_whole_and_matches_numpy():
     damage = np.array([0, 3, 40, 120, 0], dtype=np.int64)
     bonus = np.array([0, 0, 6, 2, 9], dtype=np.int64)
