@@ -231,6 +231,30 @@ def test_a_step_never_waits_for_the_device(scenario, mode, monkeypatch):
         bool(terminated.any())  # the guard does catch a read
 
 
+@pytest.mark.parametrize("mode", ["next_step", "same_step"])
+def test_a_restarted_world_plays_the_cpu_envs_next_episode(scenario, mode):
+    kwargs = SETTINGS[scenario]
+    batch = mjwarp.MazeBatchEnv(3, scenario, device="cpu", render=False, autoreset_mode=mode, **kwargs)
+    batch.reset(seed=SEED)
+    cpus = _cpu_twins(scenario, kwargs, 3, batch)
+    batch.state["steps"][1] = base.EPISODE_STEPS - 1  # world 1's episode runs out of time on the next step
+    actions = torch.tensor([2, 2, 2])
+    _, _, _, truncated, _ = batch.step(actions)
+    assert truncated.tolist() == [False, True, False]
+    if mode == "next_step":
+        batch.step(actions)  # world 1 restarts; its action is ignored
+    cpus[1].reset()  # the CPU twin's next episode
+    cpu = cpus[1].task
+    assert int(batch._config_index[1]) == cpu.config.index
+    for name, value in cpu.state.items():
+        if value.dtype.kind == "f":
+            np.testing.assert_allclose(batch.state[name][1].numpy(), value[0], rtol=0, atol=1e-9, err_msg=name)
+        else:
+            np.testing.assert_array_equal(batch.state[name][1].numpy(), value[0], err_msg=name)
+    x, y, yaw = cpus[1].physics.agent_pose()
+    assert np.allclose(batch._qpos[1, :3].double().numpy(), (x, y, yaw), atol=1e-5)
+
+
 def test_reached_through_gymnasium_by_one_word():
     envs = gymnasium.make_vec(
         "mjmaze/KItem-v1", num_envs=3, vectorization_mode="vector_entry_point", backend="warp", device="cpu",
