@@ -19,7 +19,7 @@ import time
 import mujoco
 
 import mjmaze
-from mjmaze import configs, mjcf, render
+from mjmaze import configs, mjcf, render, walls
 from mjmaze.tasks import labyrinth
 
 
@@ -32,10 +32,10 @@ def compile_arena(xml: str, size: int, config: configs.MazeConfig):
     """A freshly compiled model with ``config``'s walls and its own render context."""
     model = mujoco.MjModel.from_xml_string(xml)
     data = mujoco.MjData(model)
-    walls = mjcf.WallLayout(model, size, labyrinth.CELL_SIZE)
-    walls.apply(config.h_walls, config.v_walls)
+    layout = walls.WallLayout(model, size, labyrinth.CELL_SIZE)
+    layout.apply(config.h_walls, config.v_walls)
     renderer = render.EgoRenderer(model, "ego", 112, 64)
-    renderer.upload_mesh(walls.mesh_id)
+    renderer.upload_mesh(layout.mesh_id)
     return model, data, renderer
 
 

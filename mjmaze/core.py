@@ -22,7 +22,7 @@ from typing import Any, TypedDict
 
 import numpy as np
 
-from mjmaze import configs, mjcf, rules
+from mjmaze import configs, mjcf, palette, rules
 from mjmaze import layouts as layout_files
 
 # Timing: one physics step is one Doom tic (35 a second); the agent acts every 4 tics.
@@ -74,7 +74,7 @@ class MazeRules(abc.ABC):
     #: The scenario's name, as passed to ``mjmaze.load`` (it also enters the maze seeds).
     scenario: str = ""
     #: The colours of its walls, floor and ceiling (the released Doom textures').
-    room: mjcf.Room = mjcf.STONE_ROOM
+    room: palette.Room = palette.STONE_ROOM
     #: Whether frames show Doom's pistol (in the "textured" style). The released .cfg files say
     #: ``render_weapon = true``, but every released map's ENTER script calls ``ClearInventory()``:
     #: ViZDoom drew no weapon in any of the paper's scenarios, so none does here (the ``-v0`` ids drew one).

@@ -24,7 +24,7 @@ try:
 except ImportError as error:  # pragma: no cover - depends on the install
     raise ImportError("mjmaze.viz needs Pillow: pip install 'mjmaze[viz]'") from error
 
-from mjmaze import configs, files, mjcf, render, suite
+from mjmaze import configs, files, mjcf, render, suite, walls
 from mjmaze.tasks import base
 
 PATH_COLOUR = (255, 255, 255)
@@ -53,7 +53,7 @@ class TopDown:
         self._renderer = render.EgoRenderer(
             self.physics.model.ptr, mjcf.OVERHEAD_CAMERA, self.size, self.size, map_view=True
         )
-        self._wall_mesh = self.physics.model.ptr.mesh(mjcf.WALL_MESH).id
+        self._wall_mesh = self.physics.model.ptr.mesh(walls.WALL_MESH).id
 
     def to_pixels(self, xy) -> np.ndarray:
         """Map pixel ``(column, row)`` of world points ``xy`` (shape ``(..., 2)``)."""
@@ -141,7 +141,7 @@ def line_of_sight(config: configs.MazeConfig, start, end) -> bool:
     half = (n - 1) / 2
     (x0, y0), (x1, y1) = start, end
     # Vertical grid lines x = (j - 0.5 - half) * cell hold v_walls[:, j].
-    for lo, hi, a0, a1, b0, b1, walls in (
+    for lo, hi, a0, a1, b0, b1, line_walls in (
         (x0, x1, x0, x1, y0, y1, config.v_walls),        # crossing x lines: rows from y
         (y0, y1, y0, y1, x0, x1, config.h_walls.T),      # crossing y lines: columns from x
     ):
@@ -153,7 +153,7 @@ def line_of_sight(config: configs.MazeConfig, start, end) -> bool:
             t = ((j - 0.5 - half) * cell - a0) / (a1 - a0)
             b = b0 + t * (b1 - b0)
             i = round(b / cell + half)
-            if 0 <= i < n and walls[i, j]:
+            if 0 <= i < n and line_walls[i, j]:
                 return False
     return True
 

@@ -43,7 +43,7 @@ from gymnasium.vector import AutoresetMode
 
 import mujoco_warp as mjw
 import warp as wp
-from mjmaze import batch, core, look, mjcf, physics, rules, suite
+from mjmaze import batch, core, look, mjcf, physics, rules, suite, walls
 
 # Where a geom that must not be seen or touched in a world goes (below the floor).
 _AWAY_Z = -50.0
@@ -67,20 +67,20 @@ def build_model(task: core.MazeRules) -> tuple[mujoco.MjModel, np.ndarray, np.nd
     first_of_layout: dict[int, object] = {}
     for config, mesh in zip(all_configs, mesh_of_config):
         first_of_layout.setdefault(int(mesh), config)
-    quads = [mjcf.wall_mesh_quads(c.h_walls, c.v_walls, layout.cell_size) for c in first_of_layout.values()]
+    quads = [walls.wall_mesh_quads(c.h_walls, c.v_walls, layout.cell_size) for c in first_of_layout.values()]
     xml = mjcf.build_xml(layout.grid_size, layout.cell_size, task.objects, task.visual_style, task.room,
                          wall_layout_quads=quads)
     model = mujoco.MjModel.from_xml_string(xml)
     mjcf.paint_textures(model, task.objects)
     for mesh, config in first_of_layout.items():
-        mesh_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MESH, f"{mjcf.WALL_MESH}_{mesh}")
-        mjcf.write_wall_mesh(model, mesh_id, config.h_walls, config.v_walls, layout.cell_size)
+        mesh_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MESH, f"{walls.WALL_MESH}_{mesh}")
+        walls.write_wall_mesh(model, mesh_id, config.h_walls, config.v_walls, layout.cell_size)
     visual = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "walls_visual")
     model.geom_pos[visual] = 0.0  # mesh vertices are in world coordinates
     model.geom_quat[visual] = (1.0, 0.0, 0.0, 0.0)
-    # Boxes wall_0, wall_1, ... follow h_walls then v_walls (mjcf.wall_segments).
+    # Boxes wall_0, wall_1, ... follow h_walls then v_walls (walls.wall_segments).
     present = np.array([np.concatenate([c.h_walls.ravel(), c.v_walls.ravel()]) for c in all_configs], dtype=bool)
-    box_z = np.where(present, mjcf.WALL_HEIGHT / 2, _AWAY_Z).astype(np.float32)
+    box_z = np.where(present, walls.WALL_HEIGHT / 2, _AWAY_Z).astype(np.float32)
     return model, mesh_of_config, box_z
 
 

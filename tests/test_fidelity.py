@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import mjmaze
-from mjmaze import layouts, mjcf
+from mjmaze import layouts, walls
 from mjmaze.tasks import base, find_return, k_item, two_colour
 
 from conftest import FORWARD, TURN_LEFT, place
@@ -48,7 +48,7 @@ def test_frames_on_a_random_walk_have_dozens_of_colours(style, fewest):
 
 def wall_brightness(env, distance):
     """Mean brightness of the frame's centre, facing the +x outer wall of an empty arena from ``distance`` m."""
-    face = env.task.config.size * env.task.config.cell_size / 2 - mjcf.WALL_THICKNESS / 2
+    face = env.task.config.size * env.task.config.cell_size / 2 - walls.WALL_THICKNESS / 2
     values = []
     for y in np.linspace(-2.0, 2.0, 9):  # average over the brick pattern
         place(env, face - distance, y, 0.0)
@@ -79,7 +79,7 @@ def test_views_ninety_degrees_apart_differ_at_a_symmetric_spot(style, distinct):
 def test_texels_keep_their_size_on_walls_of_any_length():
     # Texture coordinates are metres along the wall and up it, whatever the run.
     boxes = np.array([[0.0, 0.0, 2.0, 0.0625], [5.0, 0.0, 0.5, 0.0625]])
-    verts, _, _, _, texcoords = mjcf._box_mesh(boxes)
+    verts, _, _, _, texcoords = walls._box_mesh(boxes)
     for box in range(2):
         quad = slice(box * 20, box * 20 + 4)  # the y- side: along x
         assert np.allclose(texcoords[quad, 0], verts[quad, 0])
@@ -140,7 +140,7 @@ def push(env, action, steps):
 @pytest.mark.parametrize("heading", [0.0, 30.0])
 def test_the_agent_stops_at_its_radius_from_a_wall_at_every_tic(heading):
     env = load("two_colour", complexity=0, item_cap=0)
-    face = 5.0 - mjcf.WALL_THICKNESS / 2
+    face = 5.0 - walls.WALL_THICKNESS / 2
     place(env, face - 1.0, -2.0, math.radians(heading))
     env.task.health = 10**6  # no death in 50 steps
     path = push(env, FORWARD, 50)
@@ -167,7 +167,7 @@ def test_the_agent_stops_at_its_radius_from_a_pillar_at_every_tic():
 
 
 def distance_to_walls(config, xy):
-    boxes = mjcf.wall_runs(config.h_walls, config.v_walls, config.cell_size)
+    boxes = walls.wall_runs(config.h_walls, config.v_walls, config.cell_size)
     gap_x = np.maximum(np.abs(xy[:, None, 0] - boxes[:, 0]) - boxes[:, 2], 0)
     gap_y = np.maximum(np.abs(xy[:, None, 1] - boxes[:, 1]) - boxes[:, 3], 0)
     return np.hypot(gap_x, gap_y).min(axis=1)

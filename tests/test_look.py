@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import mjmaze
-from mjmaze import look, mjcf, viz
+from mjmaze import look, palette, viz, walls
 from mjmaze.tasks import base, find_return, labyrinth, two_colour
 
 from conftest import find_cell, open_run, place
@@ -18,7 +18,7 @@ from conftest import find_cell, open_run, place
 CLOSE = 9
 
 
-def empty_room(room: mjcf.Room):
+def empty_room(room: palette.Room):
     """A 10 m arena without walls inside (Two-colour at complexity 0) coloured as ``room``, objects hidden."""
     task = base.task_class(two_colour.TwoColour)(complexity=0, item_cap=0, random=0)
     task.room = room
@@ -35,12 +35,12 @@ def frame_at(env, x, y, yaw):
 
 def wall_grey(env, distance):
     """Mean of the frame's centre facing the +x outer wall from ``distance`` m."""
-    face = env.task.config.size * env.task.config.cell_size / 2 - mjcf.WALL_THICKNESS / 2
+    face = env.task.config.size * env.task.config.cell_size / 2 - walls.WALL_THICKNESS / 2
     return frame_at(env, face - distance, 0.0, 0.0)[24:32, 50:62].mean()
 
 
 def test_walls_are_as_dim_as_vizdooms_and_brighter_near_the_eye():
-    env = empty_room(mjcf.STONE_ROOM)
+    env = empty_room(palette.STONE_ROOM)
     # ViZDoom, a STONE2 wall at sector light 160: 49, 38, 34, 30 grey at 0.5, 1, 2, 4 m.
     greys = [wall_grey(env, d) for d in (0.5, 1.0, 2.0, 4.0)]
     for got, doom in zip(greys, (49, 38, 34, 30)):
@@ -50,8 +50,8 @@ def test_walls_are_as_dim_as_vizdooms_and_brighter_near_the_eye():
 
 
 @pytest.mark.parametrize("room, floor, ceiling", [
-    (mjcf.STONE_ROOM, (48, 35, 18), (34, 34, 34)),  # FLAT1_1 brown, MFLR8_1 grey
-    (mjcf.SLIME_ROOM, (18, 35, 10), (0, 0, 17)),  # NUKAGE1 green, CEIL4_1 dark blue
+    (palette.STONE_ROOM, (48, 35, 18), (34, 34, 34)),  # FLAT1_1 brown, MFLR8_1 grey
+    (palette.SLIME_ROOM, (18, 35, 10), (0, 0, 17)),  # NUKAGE1 green, CEIL4_1 dark blue
 ])
 def test_floor_and_ceiling_have_vizdooms_colours(room, floor, ceiling):
     env = empty_room(room)
@@ -98,7 +98,7 @@ def test_the_exit_on_a_map_and_in_the_flat_style_is_its_mean_colour():
     env = mjmaze.load("labyrinth", task_kwargs={"size": 5, "random": 0, "visual_style": "flat"})
     env.reset()
     geom = env.physics.object_ids([labyrinth.EXIT.name])[1][0]
-    assert tuple(env.physics.model.geom_rgba[geom]) == pytest.approx(mjcf.GREEN_ARMOUR_RGBA)
+    assert tuple(env.physics.model.geom_rgba[geom]) == pytest.approx(palette.GREEN_ARMOUR_RGBA)
     assert env.physics.model.geom_matid[geom] == -1
     env.task.close()
 
@@ -110,7 +110,7 @@ def test_the_exit_on_a_map_and_in_the_flat_style_is_its_mean_colour():
     (two_colour.ITEMS[0].name, two_colour.ITEM_RED, (65, 28, 26)),  # Freedoom's "blue" armour, red
 ])
 def test_two_colour_objects_2m_ahead_have_vizdooms_colours(name, rgba, doom):
-    env = empty_room(mjcf.SLIME_ROOM)
+    env = empty_room(palette.SLIME_ROOM)
     physics = env.physics
     ids = physics.object_ids([name])
     physics.set_object_rgba(ids[1][0], rgba)
@@ -125,7 +125,7 @@ def test_k_items_first_two_kinds_are_the_released_armours_as_vizdoom_draws_them(
 
     green, red = (geom for _, geom in k_item.KINDS[:2])
     assert (green.rgba, red.rgba) == (two_colour.ITEM_GREEN, two_colour.ITEM_RED)
-    env = empty_room(mjcf.STONE_ROOM)  # K-item's room
+    env = empty_room(palette.STONE_ROOM)  # K-item's room
     physics = env.physics
     ids = physics.object_ids([two_colour.ITEMS[0].name])
     physics.set_object_rgba(ids[1][0], green.rgba)
@@ -137,8 +137,8 @@ def test_k_items_first_two_kinds_are_the_released_armours_as_vizdoom_draws_them(
 
 
 def test_find_return_pillars_are_doom_columns():
-    assert find_return.RED_PILLAR.rgba == mjcf.TALL_RED_COLUMN_RGBA == two_colour.RED
-    assert find_return.GREEN_PILLAR.rgba == mjcf.TALL_GREEN_COLUMN_RGBA == two_colour.GREEN
+    assert find_return.RED_PILLAR.rgba == palette.TALL_RED_COLUMN_RGBA == two_colour.RED
+    assert find_return.GREEN_PILLAR.rgba == palette.TALL_GREEN_COLUMN_RGBA == two_colour.GREEN
 
 
 def test_the_pistol_when_asked_for_hides_a_floor_item_right_ahead():

@@ -15,7 +15,7 @@ units up, the sector at UDMF's default light (160, none is set), things by the
 released type numbers. ViZDoom draws it with the released settings (320x180,
 the pistol shown, no HUD) and the released env's area resize to 112x64.
 ``--calibrate`` prints ViZDoom's mean colours beside mjmaze's: where
-``mjmaze.mjcf``'s rooms and lamp and the scenarios' object colours come from
+``mjmaze.palette``'s rooms and lamp and the scenarios' object colours come from
 (docs/look.md), and what ``tests/test_look.py`` holds.
 """
 
@@ -32,7 +32,7 @@ import imageio.v3 as iio
 import numpy as np
 
 import mjmaze
-from mjmaze import configs, look, maze
+from mjmaze import configs, look, maze, palette
 from mjmaze.tasks import base, find_return, k_item, two_colour
 
 UNITS = 128  # Doom map units per metre (mjmaze's 1 m cell is the generator's 128 units)
@@ -253,10 +253,8 @@ def exit_figure() -> None:
 
 def empty_arena(room: str, pistol: bool = True):
     """An empty 10 m arena (Two-colour at complexity 0) coloured as ``room``, its objects hidden."""
-    from mjmaze import mjcf
-
     task = base.task_class(two_colour.TwoColour)(complexity=0, item_cap=0, flashes=False)
-    task.room = {"stone": mjcf.STONE_ROOM, "slime": mjcf.SLIME_ROOM}[room]
+    task.room = {"stone": palette.STONE_ROOM, "slime": palette.SLIME_ROOM}[room]
     task.pistol = pistol  # as the ViZDoom probe beside it (released_game's weapon)
     env = base.make_environment(task)
     env.reset()

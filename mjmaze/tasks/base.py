@@ -20,7 +20,7 @@ from dm_control.rl import control
 from dm_control.suite import base
 from dm_env import specs
 
-from mjmaze import configs, core, look, mjcf, render, rules
+from mjmaze import configs, core, look, mjcf, render, rules, walls
 # The timing, motion and action names scenario code and tests read as base.*.
 from mjmaze.core import (  # noqa: F401
     ACTION_NAMES, ACTION_SETS, AGENT_RADIUS, DEFAULT_HEIGHT, DEFAULT_WIDTH, EPISODE_STEPS, PICKUP_RADIUS,
@@ -53,7 +53,7 @@ class MazeTask(core.MazeRules, base.Task):
         self._renderer: render.EgoRenderer | None = None
         #: The ego camera's horizontal field of view in radians (known once the task has a physics).
         self.horizontal_fov = math.nan
-        self._walls: mjcf.WallLayout | None = None
+        self._walls: walls.WallLayout | None = None
         self._bound_data = None
         self.config: configs.MazeConfig | None = None
         self._config_in_model: configs.MazeConfig | None = None
@@ -82,7 +82,7 @@ class MazeTask(core.MazeRules, base.Task):
         model = physics.model.ptr
         self._model, self._bound_data = model, data
         self._qpos, self._qvel = data.qpos, data.qvel
-        self._walls = mjcf.WallLayout(model, self.layout.grid_size, self.layout.cell_size)
+        self._walls = walls.WallLayout(model, self.layout.grid_size, self.layout.cell_size)
         self._renderer = render.EgoRenderer(model, CAMERA, self.width, self.height)
         self._eye = model.cam(CAMERA).pos  # a view into the model: head-bob moves it
         fovy = math.radians(model.cam(CAMERA).fovy[0])

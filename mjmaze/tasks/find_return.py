@@ -25,7 +25,7 @@ Version History
 
 from __future__ import annotations
 
-from mjmaze import configs, core, maze, mjcf, registry, rules
+from mjmaze import configs, core, maze, mjcf, palette, registry, rules
 
 
 SIZES = (5, 7, 9, 11, 13)
@@ -43,11 +43,11 @@ PILLAR_HEIGHT = 52 * mjcf.MAP_UNIT
 SPAWN_OFFSET = 0.25
 
 GREEN_PILLAR = mjcf.ObjectGeom(
-    "green_pillar", "cylinder", (PILLAR_RADIUS, PILLAR_HEIGHT / 2), mjcf.TALL_GREEN_COLUMN_RGBA, PILLAR_HEIGHT / 2,
+    "green_pillar", "cylinder", (PILLAR_RADIUS, PILLAR_HEIGHT / 2), palette.TALL_GREEN_COLUMN_RGBA, PILLAR_HEIGHT / 2,
     collides=True,
 )
 RED_PILLAR = mjcf.ObjectGeom(
-    "red_pillar", "cylinder", (PILLAR_RADIUS, PILLAR_HEIGHT / 2), mjcf.TALL_RED_COLUMN_RGBA, PILLAR_HEIGHT / 2,
+    "red_pillar", "cylinder", (PILLAR_RADIUS, PILLAR_HEIGHT / 2), palette.TALL_RED_COLUMN_RGBA, PILLAR_HEIGHT / 2,
     collides=True,
 )
 

@@ -30,7 +30,7 @@ Version History
 
 from __future__ import annotations
 
-from mjmaze import configs, core, maze, mjcf, registry, rules
+from mjmaze import configs, core, maze, mjcf, palette, registry, rules
 
 
 NUM_ITEMS = tuple(range(1, 9))
@@ -55,8 +55,8 @@ STEP_REWARD = -0.0001 * core.TICS_PER_STEP
 # medikit, soulsphere and keycards are not measured yet.
 # The two greys (K = 8) are not in the released files we have: our shapes.
 KINDS = (
-    ("g", mjcf.floor_thing("item_green", "cylinder", 31, 17, mjcf.GREEN_ARMOUR_RGBA)),
-    ("r", mjcf.floor_thing("item_red", "cylinder", 31, 17, mjcf.RED_ARMOUR_RGBA)),
+    ("g", mjcf.floor_thing("item_green", "cylinder", 31, 17, palette.GREEN_ARMOUR_RGBA)),
+    ("r", mjcf.floor_thing("item_red", "cylinder", 31, 17, palette.RED_ARMOUR_RGBA)),
     ("b", mjcf.floor_thing("item_blue", "cylinder", 28, 19, (0.15, 0.25, 1.0, 1.0))),
     ("c", mjcf.floor_thing("item_cyan", "sphere", 24, 24, (0.0, 0.9, 0.9, 1.0))),
     ("m", mjcf.floor_thing("item_magenta", "cylinder", 14, 16, (0.9, 0.1, 0.9, 1.0))),

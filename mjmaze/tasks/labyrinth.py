@@ -28,7 +28,7 @@ Version History
 
 from __future__ import annotations
 
-from mjmaze import configs, core, maze, mjcf, registry, rules
+from mjmaze import configs, core, maze, mjcf, palette, registry, rules
 
 
 SIZES = (5, 7, 9, 11, 13)
@@ -47,8 +47,8 @@ STEP_REWARD = -0.0001 * core.TICS_PER_STEP
 # grey plates, vivid green chest and dark edge as bands around that mean.
 EXIT_RADIUS, EXIT_HEIGHT = 0.12, 16 * mjcf.MAP_UNIT
 EXIT = mjcf.ObjectGeom(
-    "exit", "cylinder", (EXIT_RADIUS, EXIT_HEIGHT / 2), mjcf.GREEN_ARMOUR_RGBA, z=EXIT_HEIGHT / 2,
-    bands=mjcf.GREEN_ARMOUR_BANDS,
+    "exit", "cylinder", (EXIT_RADIUS, EXIT_HEIGHT / 2), palette.GREEN_ARMOUR_RGBA, z=EXIT_HEIGHT / 2,
+    bands=palette.GREEN_ARMOUR_BANDS,
 )
 
 

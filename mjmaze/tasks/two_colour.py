@@ -44,7 +44,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mjmaze import configs, core, mjcf, registry, rules
+from mjmaze import configs, core, mjcf, palette, registry, rules, walls
 
 
 COMPLEXITIES = tuple(range(0, 11))
@@ -95,8 +95,8 @@ _CHUNK_ELEMENTS = 1 << 24
 # Find-and-return's pillars); the items are Freedoom's green armour and its
 # "blue" armour, which Freedoom draws red (the released ACS calls it the red
 # armour), lying on the floor at their sprites' size; colours as ViZDoom draws them.
-RED, GREEN = mjcf.TALL_RED_COLUMN_RGBA, mjcf.TALL_GREEN_COLUMN_RGBA
-ITEM_RED, ITEM_GREEN = mjcf.RED_ARMOUR_RGBA, mjcf.GREEN_ARMOUR_RGBA
+RED, GREEN = palette.TALL_RED_COLUMN_RGBA, palette.TALL_GREEN_COLUMN_RGBA
+ITEM_RED, ITEM_GREEN = palette.RED_ARMOUR_RGBA, palette.GREEN_ARMOUR_RGBA
 TOTEM = mjcf.floor_thing("totem", "cylinder", 32, 52, RED, collides=True)
 TOTEM_RADIUS = TOTEM.size[0]
 # The agent's centre never comes closer to the totem's than this.
@@ -110,7 +110,7 @@ class TwoColour(core.MazeRules):
     """Pick up items of the totem's colour to stay alive; see the module docstring."""
 
     scenario = "two_colour"
-    room = mjcf.SLIME_ROOM
+    room = palette.SLIME_ROOM
     objects = (TOTEM, *ITEMS)
     # 20 items, each tried at 32 points against every wall box: ~20x a step's spawn.
     costly_start = True
@@ -137,11 +137,11 @@ class TwoColour(core.MazeRules):
         # Each maze's wall boxes (x, y, half x, half y), padded with boxes far
         # away to one fixed count (every segment a run of its own at most), so
         # that any set of configurations stacks.
-        runs = [mjcf.wall_runs(config.h_walls, config.v_walls, config.cell_size) for config in configs_]
-        walls = np.tile(np.array([_FAR_AWAY, _FAR_AWAY, 0.0, 0.0]), (len(configs_), 2 * GRID_SIZE * (GRID_SIZE + 1), 1))
-        for row, boxes in zip(walls, runs):
+        runs = [walls.wall_runs(config.h_walls, config.v_walls, config.cell_size) for config in configs_]
+        padded = np.tile(np.array([_FAR_AWAY, _FAR_AWAY, 0.0, 0.0]), (len(configs_), 2 * GRID_SIZE * (GRID_SIZE + 1), 1))
+        for row, boxes in zip(padded, runs):
             row[: len(boxes)] = boxes
-        arrays["walls"] = walls
+        arrays["walls"] = padded
         return arrays
 
     def start(self, xp, config, keys):
@@ -253,7 +253,7 @@ class TwoColour(core.MazeRules):
         candidate = xp.arange(ITEM_CANDIDATES, dtype=xp.int64, device=device)[None, None, :, None]
         axis = xp.arange(2, dtype=xp.int64, device=device)[None, None, None, :]
         half = GRID_SIZE * CELL_SIZE / 2
-        walls = state["walls"][:, None, None, :, :]  # (B, 1, 1, W, 4)
+        boxes = state["walls"][:, None, None, :, :]  # (B, 1, 1, W, 4)
         totem_xy = state["object_xy"][:, 0][:, None, None, :]
         # In chunks of items: the wall test is (B, K, candidates, W).
         per_item = batch * ITEM_CANDIDATES * state["walls"].shape[1]
@@ -263,8 +263,8 @@ class TwoColour(core.MazeRules):
             part = items[:, begin : begin + chunk]
             u = rules.uniform(xp, keys[:, None, None, None], rules.DRAW_ITEM, part[:, :, None, None], candidate, axis)
             points = (2 * u - 1) * half  # (B, k, candidates, 2)
-            gap_x = xp.clip(xp.abs(points[..., 0:1] - walls[..., 0]) - walls[..., 2], min=0.0)
-            gap_y = xp.clip(xp.abs(points[..., 1:2] - walls[..., 1]) - walls[..., 3], min=0.0)
+            gap_x = xp.clip(xp.abs(points[..., 0:1] - boxes[..., 0]) - boxes[..., 2], min=0.0)
+            gap_y = xp.clip(xp.abs(points[..., 1:2] - boxes[..., 1]) - boxes[..., 3], min=0.0)
             free = (
                 (xp.min(gap_x * gap_x + gap_y * gap_y, axis=-1) >= ITEM_WALL_CLEARANCE**2)
                 & (xp.sum((points - totem_xy) ** 2, axis=-1) >= TOTEM_CLEARANCE**2)

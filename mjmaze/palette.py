@@ -1,0 +1,92 @@
+"""Doom's colours and light as ViZDoom draws the released maps, and the textures that carry them.
+
+Every number here was measured in ViZDoom against mjmaze's frames
+(``python tools/doom_frames.py --calibrate``; docs/look.md): the rooms' mean
+colours, the things' colours, the armour sprite's bands, the light that fades
+with distance, and the grey texture patterns with the gains that keep each
+surface's mean colour. :mod:`mjmaze.mjcf` writes them into the arena.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+@dataclasses.dataclass(frozen=True)
+class Room:
+    """The colours (0-1) of a scenario's walls, floor and ceiling.
+
+    They make mjmaze's frames show the mean colours of the released scenario's
+    Doom textures as ViZDoom draws them at the released sector light (160):
+    walls and floor are lit (:func:`mjmaze.mjcf.add_distance_falloff`), the ceiling is
+    seen in its colour as is. ``python tools/doom_frames.py --calibrate`` prints
+    ViZDoom's colours beside mjmaze's (docs/look.md).
+    """
+
+    wall: tuple[float, float, float]
+    floor: tuple[float, float, float]
+    ceiling: tuple[float, float, float]
+
+
+#: Labyrinth, Find-and-return and K-item: ``STONE2`` walls (grey), ``FLAT1_1``
+#: floor (brown), ``MFLR8_1`` ceiling (grey), as the released generators write them.
+STONE_ROOM = Room(wall=(0.33, 0.33, 0.33), floor=(0.52, 0.40, 0.19), ceiling=(0.133, 0.133, 0.133))
+#: Two-colour: ``GSTONE1`` walls (green-grey), ``NUKAGE1`` floor (green slime), ``CEIL4_1`` ceiling.
+SLIME_ROOM = Room(wall=(0.39, 0.42, 0.28), floor=(0.20, 0.40, 0.13), ceiling=(0.0, 0.0, 0.067))
+#: Doom's tall green and red columns (things 30, 32: Find-and-return's pillars,
+#: Two-colour's totem) as ViZDoom draws them, on a cylinder of their radius.
+TALL_GREEN_COLUMN_RGBA = (0.24, 0.51, 0.17, 1.0)
+TALL_RED_COLUMN_RGBA = (0.73, 0.06, 0.04, 1.0)
+#: Freedoom's green armour (thing 2018: the Labyrinth exit, Two-colour's green
+#: items) and its "blue" armour (2019), which Freedoom draws red (Two-colour's
+#: red items), averaged over their blink, on a floor cylinder of their size.
+GREEN_ARMOUR_RGBA = (0.52, 0.63, 0.39, 1.0)
+RED_ARMOUR_RGBA = (0.73, 0.31, 0.30, 1.0)
+#: The green armour's sprite (Freedoom's ARM1, 542 pixels) read from top to
+#: bottom as ``(share of its pixels, their mean colour)``: the grey shoulder
+#: plates, the green chest, the dark lower edge. ViZDoom's frames of the
+#: released maps show it so (51% grey, 26% vivid green: docs/paper_agents.md);
+#: drawn as horizontal bands on the object's side (:attr:`ObjectGeom.bands`),
+#: the olive mean alone hid the vivid part agents look for.
+GREEN_ARMOUR_BANDS = (
+    (0.52, (0.308, 0.297, 0.281)),
+    (0.28, (0.199, 0.422, 0.158)),
+    (0.20, (0.157, 0.136, 0.074)),
+)
+#: Ambient light everywhere, then a lamp at the eye adding ``LAMP_DIFFUSE x cos / (0.05 + d)``
+#: at ``d`` metres: Doom's light diminishing at sector light 160, which ViZDoom
+#: draws as 27 + 12 / d grey levels on a ``STONE2`` wall ``d`` map cells ahead.
+AMBIENT = 0.28
+LAMP_DIFFUSE = 0.30
+LAMP_ATTENUATION = (0.05, 1.0, 0.0)
+TEXTURE_TEXELS = 64  # per side of a texture; one texture covers 1 m x 1 m
+# 1 / the mean grey of each texture (see _brick_texels, _tile_texels).
+TEXTURE_GAIN = {"wall": 1.35, "floor": 1.6}
+
+
+def brick_texels() -> np.ndarray:
+    """Bricks 0.25 x 0.125 m in courses offset by half a brick, dark mortar, grain (grey, mean ~1/TEXTURE_GAIN)."""
+    n = TEXTURE_TEXELS
+    rng = np.random.default_rng(1)
+    rows, cols = np.mgrid[0:n, 0:n]
+    course = rows * 8 // n  # 8 courses per metre
+    shifted = (cols + (course % 2) * n // 8) % n  # every other course offset by half a brick
+    grey = rng.uniform(0.72, 1.0, size=(8, 4))[course, shifted * 4 // n] * rng.uniform(0.9, 1.0, size=(n, n))
+    grey[(rows % (n // 8) == 0) | (shifted % (n // 4) == 0)] = 0.4  # mortar
+    return _grey_to_rgb(grey)
+
+
+def tile_texels() -> np.ndarray:
+    """Tiles 0.5 m with dark joints and mottled grain (grey, mean ~1/TEXTURE_GAIN)."""
+    n = TEXTURE_TEXELS
+    rng = np.random.default_rng(2)
+    rows, cols = np.mgrid[0:n, 0:n]
+    tile = (rows * 2 // n) * 2 + cols * 2 // n
+    grey = rng.uniform(0.6, 0.8, size=4)[tile] * rng.uniform(0.85, 1.0, size=(n, n))
+    grey[(rows % (n // 2) == 0) | (cols % (n // 2) == 0)] = 0.35  # dark joints, as FLAT1_1's
+    return _grey_to_rgb(grey)
+
+
+def _grey_to_rgb(grey: np.ndarray) -> np.ndarray:
+    return np.repeat((np.clip(grey, 0, 1) * 255).astype(np.uint8)[..., None], 3, axis=2)
