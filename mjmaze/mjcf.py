@@ -186,7 +186,7 @@ def build_xml(
             # geom bounding boxes from compile time, so boxes never move.
             size=f"{hx} {hy} {walls.WALL_HEIGHT / 2}", pos=f"{x} {y} {walls.WALL_HEIGHT / 2}",
         )
-    colliding = []  # batch: the colliding objects' attributes, placed last
+    colliding = []  # batch: (object, attributes) of the colliding objects, placed after the others
     for obj in objects:  # see ObjectGeom
         rgba = obj.rgba
         attrs = dict(name=obj.name, type=obj.type, size=" ".join(map(str, obj.size)))
@@ -200,15 +200,16 @@ def build_xml(
             attrs["material"] = obj.name
             rgba = (*np.minimum(np.array(obj.rgba[:3]) * gain, 1.0).round(4).tolist(), obj.rgba[3])
         attrs["rgba"] = " ".join(map(str, rgba))
-        if batch:
-            colliding.append(attrs) if obj.collides else ET.SubElement(
-                arena, "geom", **{"class": "item"}, pos=f"0 0 {obj.z}", group=str(VISIBLE_GROUP), **attrs)
+        if batch and obj.collides:
+            colliding.append((obj, attrs))
+        elif batch:
+            ET.SubElement(arena, "geom", **{"class": "item"}, pos=f"0 0 {obj.z}", group=str(VISIBLE_GROUP), **attrs)
         elif obj.collides:
             body = ET.SubElement(worldbody, "body", name=obj.name, mocap="true", pos=f"0 0 {obj.z}")
             ET.SubElement(body, "geom", **{"class": "item"}, contype="1", conaffinity="1", **attrs)
         else:
             ET.SubElement(worldbody, "geom", **{"class": "item"}, pos=f"0 0 {obj.z}", **attrs)
-    for attrs, obj in zip(colliding, [obj for obj in objects if obj.collides]):  # batch: after the others
+    for obj, attrs in colliding:
         ET.SubElement(arena, "geom", **{"class": "item"}, pos=f"0 0 {obj.z}", group=str(VISIBLE_GROUP), **attrs)
         ET.SubElement(arena, "geom", **{"class": "item"}, pos=f"0 0 {obj.z}", **{
             **attrs, "name": obj.name + COLLISION_SUFFIX, "group": "3", "contype": "1", "conaffinity": "1"})

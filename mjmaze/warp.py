@@ -297,15 +297,18 @@ class MazeBatchEnv(batch.BatchEnv):
         start = task.start_state(xp, {name: value[config_index] for name, value in self._config_table.items()}, keys)
         if self.state is None:
             self.state = start
-            return self._start_arena(start, config_index, restart)
-        # The start where ``restart`` is set, the current state elsewhere, over every env.
-        start = {name: _scatter_rows(self.state[name], envs, value) for name, value in start.items()}
-        config_index = _scatter_rows(self._config_index, envs, config_index)
-        self.state = {name: _where_rows(restart, value, self.state[name]) for name, value in start.items()}
-        self._start_arena(start, config_index, restart)
+        elif isinstance(envs, slice):  # every env worked out: the start where ``restart`` is set
+            self.state = {name: _where_rows(restart, value, self.state[name]) for name, value in start.items()}
+        else:  # the restarting envs alone: their rows
+            self.state = {name: _scatter_rows(self.state[name], envs, value) for name, value in start.items()}
+            config_index = _scatter_rows(self._config_index, envs, config_index)
+        self._start_arena(self.state, config_index, restart)
 
     def _start_arena(self, start: dict, config_index: torch.Tensor, restart: torch.Tensor) -> None:
-        """Puts every env where ``restart`` is set at its start: agent, maze, object colours."""
+        """Puts every env where ``restart`` is set at its start: agent, maze, object colours.
+
+        ``start`` and ``config_index`` hold a row for every env; only the restarting ones are read.
+        """
         self._episodes = self._episodes + restart.long()
         self._config_index = torch.where(restart, config_index, self._config_index)
         rows = restart[:, None]
@@ -391,10 +394,8 @@ def _where_rows(rows: torch.Tensor, new: torch.Tensor, old: torch.Tensor) -> tor
     return torch.where(rows.view(-1, *([1] * (new.dim() - 1))), new, old)
 
 
-def _scatter_rows(full: torch.Tensor, envs, rows: torch.Tensor) -> torch.Tensor:
-    """``rows`` of envs ``envs`` written into a copy of ``full`` (all of it for ``envs = slice(None)``)."""
-    if isinstance(envs, slice):
-        return rows
+def _scatter_rows(full: torch.Tensor, envs: torch.Tensor, rows: torch.Tensor) -> torch.Tensor:
+    """``rows`` of envs ``envs`` (indices) written into a copy of ``full``."""
     full = full.clone()
     full[envs] = rows
     return full

@@ -11,6 +11,13 @@ import mjmaze
 from mjmaze import maze
 
 FORWARD, TURN_LEFT, TURN_RIGHT = 2, 0, 1
+# Each scenario at a small setting: for tests that run every scenario on torch or MuJoCo Warp (compile and step time).
+SMALL_SETTINGS = {
+    "labyrinth": {"size": 5},
+    "find_return": {"size": 5},
+    "k_item": {"num_items": 4},
+    "two_colour": {"complexity": 3},
+}
 
 
 def place(env, x: float, y: float, yaw: float) -> None:
@@ -46,4 +53,4 @@ def yaw_difference(a: float, b: float) -> float:
     return abs(math.remainder(a - b, math.tau))
 
 
-__all__ = ["FORWARD", "TURN_LEFT", "TURN_RIGHT", "place", "find_cell", "open_run", "yaw_difference", "np"]
+__all__ = ["FORWARD", "TURN_LEFT", "TURN_RIGHT", "SMALL_SETTINGS", "place", "find_cell", "open_run", "yaw_difference", "np"]

@@ -14,19 +14,16 @@ import pytest
 
 from mjmaze import rules, suite
 
+from conftest import SMALL_SETTINGS
+
 torch = pytest.importorskip("torch")
 
-SETTINGS = {
-    "labyrinth": {"size": 5},
-    "find_return": {"size": 5},
-    "k_item": {"num_items": 4},
-    "two_colour": {"complexity": 3},
-}
+SETTINGS = SMALL_SETTINGS
 NUM_ENVS = 6
 STEPS = 12
 
 
-def _paths(state, step: int, xp) -> np.ndarray:
+def _paths(state, step: int) -> np.ndarray:
     """Each env's 4 tics this step: from its spawn toward one of its objects (a different one each step)."""
     xy = np.asarray(state["object_xy"])
     shown = np.asarray(state["object_shown"])
@@ -58,7 +55,7 @@ def test_rules_compile_whole_and_match_numpy(scenario):
     _assert_same(on_numpy, on_torch, "start")
     rewards_seen = 0
     for k in range(STEPS):
-        path = _paths(on_numpy, k, np)
+        path = _paths(on_numpy, k)
         expected = task.step_state(np, on_numpy, path)
         got = step(on_torch, torch.as_tensor(path))
         for name, a, b in zip(("reward", "terminated", "truncated"), expected, got):

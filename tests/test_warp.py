@@ -19,18 +19,14 @@ import mjmaze
 from mjmaze import look, mjcf, registry, rules, suite
 from mjmaze.tasks import base
 
+from conftest import SMALL_SETTINGS
+
 pytestmark = [pytest.mark.warp, pytest.mark.slow]
 torch = pytest.importorskip("torch")
 pytest.importorskip("mujoco_warp")
 from mjmaze import warp as mjwarp  # noqa: E402
 
-# Each scenario at a small setting (compile and step time on CPU).
-SETTINGS = {
-    "labyrinth": {"size": 5},
-    "find_return": {"size": 5},
-    "k_item": {"num_items": 4},
-    "two_colour": {"complexity": 3},
-}
+SETTINGS = SMALL_SETTINGS
 SEED = 7
 # Frames of the same pose: Warp's ray tracer filters textures where GL samples
 # the nearest texel, and shades per pixel where GL shades per vertex.
