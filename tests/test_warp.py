@@ -209,10 +209,12 @@ def _no_reads_from_the_device(monkeypatch):
         yield
 
 
-@pytest.mark.parametrize("scenario", [name for name in SETTINGS if not registry.get(name).task.costly_start])
+@pytest.mark.parametrize("scenario", list(SETTINGS))
 @pytest.mark.parametrize("mode", ["next_step", "same_step"])
 def test_a_step_never_waits_for_the_device(scenario, mode, monkeypatch):
-    batch = mjwarp.MazeBatchEnv(3, scenario, device="cpu", autoreset_mode=mode, **SETTINGS[scenario])
+    # As on a GPU: every world's start under the mask, even a costly one (on the CPU, by default, by index).
+    batch = mjwarp.MazeBatchEnv(3, scenario, device="cpu", autoreset_mode=mode, restart_by_index=False, **SETTINGS[scenario])
+    assert batch.restart_by_index is False
     batch.reset(seed=SEED)
     actions = torch.tensor([2, 0, 1])
     ends = 0
@@ -227,10 +229,11 @@ def test_a_step_never_waits_for_the_device(scenario, mode, monkeypatch):
         bool(terminated.any())  # the guard does catch a read
 
 
+@pytest.mark.parametrize("by_index", [False, True])
 @pytest.mark.parametrize("mode", ["next_step", "same_step"])
-def test_a_restarted_world_plays_the_cpu_envs_next_episode(scenario, mode):
+def test_a_restarted_world_plays_the_cpu_envs_next_episode(scenario, mode, by_index):
     kwargs = SETTINGS[scenario]
-    batch = mjwarp.MazeBatchEnv(3, scenario, device="cpu", render=False, autoreset_mode=mode, **kwargs)
+    batch = mjwarp.MazeBatchEnv(3, scenario, device="cpu", render=False, autoreset_mode=mode, restart_by_index=by_index, **kwargs)
     batch.reset(seed=SEED)
     cpus = _cpu_twins(scenario, kwargs, 3, batch)
     batch.state["steps"][1] = base.EPISODE_STEPS - 1  # world 1's episode runs out of time on the next step
