@@ -2,6 +2,7 @@
 
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT [--only labyrinth_9 two_colour_1] [--out FILE]
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --agreement labyrinth_7   # the same action at the same pose?
+    python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --agreement two_colour_1  # ... with ViZDoom's items placed
 
 RELEASED_CHECKOUT is a checkout of github.com/edbeeching/3d_control_deep_rl
 (its ``3dcdrl/scenarios/custom_scenarios/`` holds each maze's ``.cfg``/``.wad``,
@@ -44,7 +45,7 @@ PLAYS_PER_MAZE = 2
 BATCH = 16  # mazes played side by side (one network batch)
 
 
-def _game(cfg: pathlib.Path, seed: int = 0):
+def _game(cfg: pathlib.Path, seed: int = 0, objects: bool = False):
     import vizdoom as vzd
 
     game = vzd.DoomGame()
@@ -53,6 +54,7 @@ def _game(cfg: pathlib.Path, seed: int = 0):
     game.set_screen_resolution(vzd.ScreenResolution.RES_320X180)  # as the released env sets it after the cfg
     game.set_sound_enabled(False)
     game.set_window_visible(False)
+    game.set_objects_info_enabled(objects)  # every thing's name and position, each state
     game.init()
     return game
 
@@ -125,15 +127,20 @@ def play(job: tuple[str, str, str]) -> tuple[str, str, dict]:
     }
 
 
-def agreement(name: str, checkout: str, mazes: int = 8) -> float:
+def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False) -> float:
     """How often the agent chooses, on mjmaze's frame, the action it chose on ViZDoom's frame at the same pose.
 
     The agent plays the first ``mazes`` test mazes greedily in ViZDoom; each of
     its poses is then set in mjmaze (head-bob off: its phase is ViZDoom's own)
     and mjmaze's frame goes through the same network, its memory fed by
     mjmaze's frames along the same path. 1.0 would mean the agent cannot tell
-    the engines apart along its own path. Labyrinth only: the other
-    scenarios' things move or appear at random, so their poses alone do not fix the view.
+    the engines apart along its own path. Labyrinth, and Two-colour: there the
+    items and the totem on the floor at each pose are ViZDoom's (its objects
+    list) and Doom's flash counters are followed from the health, tic by tic
+    (a hit adds its damage, a pick-up 6; each tic takes 1); ``hide_items``
+    leaves the items out of mjmaze's frames, to see how much the agent's
+    choices rest on them. Find-and-return and K-item would need their
+    random spawn headings matched; they are left out.
     """
     import math
 
@@ -142,38 +149,84 @@ def agreement(name: str, checkout: str, mazes: int = 8) -> float:
     import mjmaze
 
     info = paper_agents.get(name)
+    two_colour = info.scenario == "two_colour"
     _, agent, _ = paper_agents.load(name, paper_dir=checkout)
     folder = pathlib.Path(checkout) / paper_agents.MAZES / info.maze_folder / "test"
     env = mjmaze.load(info.scenario, task_kwargs={**info.task_kwargs, "layouts": str(folder), "head_bob": False})
+    task = env.task
     same = []
     for index in range(mazes):
         maze = json.loads((folder / f"custom_scenario{index:03d}.json").read_text())
         centre = np.mean(np.array(maze["exterior"], dtype=float), axis=0)  # mjmaze centres the maze on (0, 0)
-        game = _game(folder / f"custom_scenario{index:03d}.cfg", seed=index)
+        game = _game(folder / f"custom_scenario{index:03d}.cfg", seed=index, objects=two_colour)
         path = []
         hidden, start = agent.initial_state(1), torch.ones(1, dtype=torch.bool)
+        health, flashes = game.get_game_variable(vzd.GameVariable.HEALTH), [0, 0]  # damage, bonus counts
         while not game.is_episode_finished():
             x, y, angle = (game.get_game_variable(getattr(vzd.GameVariable, v)) for v in _POSE)
+            things = _two_colour_things(game, centre) if two_colour else None
             with torch.no_grad():
                 logits, _, hidden = agent.step(agent.features(torch.from_numpy(_frame(game)[None])), hidden, start)
             start[:] = False
-            path.append(((x - centre[0]) / 128, (y - centre[1]) / 128, math.radians(angle), int(logits.argmax())))
-            game.make_action(LIMITED_ACTIONS[path[-1][3]], FRAME_SKIP)
+            action = int(logits.argmax())
+            path.append(((x - centre[0]) / 128, (y - centre[1]) / 128, math.radians(angle), action, things, tuple(flashes)))
+            for _ in range(FRAME_SKIP):  # tic by tic, to follow the flash counters
+                game.make_action(LIMITED_ACTIONS[action], 1)
+                flashes = [max(count - 1, 0) for count in flashes]
+                if game.is_episode_finished():
+                    break
+                now = game.get_game_variable(vzd.GameVariable.HEALTH)
+                if now < health:
+                    flashes[0] = min(flashes[0] + int(health - now), 100)
+                if now > health or now <= health - 12:  # an item: +25, or a wrong one's 13 or 17
+                    flashes[1] += 6
+                health = now
         game.close()
         env.reset()
-        while env.task.config.index != index:
+        while task.config.index != index:
             env.reset()
         hidden, start = agent.initial_state(1), torch.ones(1, dtype=torch.bool)
-        for x, y, yaw, action in path:
+        for x, y, yaw, action, things, flashes in path:
+            if two_colour:
+                _place_two_colour_things(task, env.physics, things, flashes, hide_items)
             env.physics.set_agent_pose(x, y, yaw)
             env.physics.forward()
-            frame = np.ascontiguousarray(env.task.get_observation(env.physics)["pixels"])
+            frame = np.ascontiguousarray(task.get_observation(env.physics)["pixels"])
             with torch.no_grad():
                 logits, _, hidden = agent.step(agent.features(torch.from_numpy(frame[None])), hidden, start)
             start[:] = False
             same.append(int(logits.argmax()) == action)
-    env.task.close()
+    task.close()
     return float(np.mean(same))
+
+
+def _two_colour_things(game, centre: np.ndarray) -> tuple[list, bool]:
+    """ViZDoom's Two-colour items ``[(x, y, green)]`` in mjmaze's metres, and whether the totem is green."""
+    objects = game.get_state().objects
+    items = [((o.position_x - centre[0]) / 128, (o.position_y - centre[1]) / 128, o.name == "GreenArmor")
+             for o in objects if o.name in ("GreenArmor", "BlueArmor")]
+    # The script moves one of two columns parked 4,000 units away onto the totem's spot.
+    totem = next(o for o in objects if o.name.endswith("Column") and abs(o.position_x - centre[0]) < 2000)
+    return items, "Green" in totem.name
+
+
+def _place_two_colour_things(task, physics, things: tuple[list, bool], flashes: tuple[int, int], hide: bool) -> None:
+    """Sets mjmaze's Two-colour episode to ViZDoom's things and flash counters (items of a colour fill its slots in turn)."""
+    from mjmaze.tasks import two_colour
+
+    items, totem_green = things
+    state, row = task.state, task.row
+    state["totem_green"][row] = totem_green
+    state["object_rgba"][row, 0] = two_colour.TOTEM_COLOURS[int(totem_green)]
+    shown, xy, used = np.zeros(two_colour.POOL_SIZE, dtype=bool), np.zeros((two_colour.POOL_SIZE, 2)), [0, 0]
+    for x, y, green in items:
+        slot = 2 * used[0] if green else 2 * used[1] + 1  # green items are the even slots
+        used[0 if green else 1] += 1
+        if slot < two_colour.POOL_SIZE:
+            shown[slot], xy[slot] = not hide, (x, y)
+    state["object_xy"][row, 1:], state["object_shown"][row, 1:] = xy, shown
+    state["damage_count"][row], state["bonus_count"][row] = flashes
+    task._sync_objects(physics, everything=True)
 
 
 def main() -> None:
@@ -183,13 +236,17 @@ def main() -> None:
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("runs/paper/vizdoom.json"))
     parser.add_argument("--processes", type=int, default=None, help="default: one per core")
     parser.add_argument("--agreement", metavar="SETTING", default=None,
-                        help="instead: how often a Labyrinth agent acts alike on both engines' frames at the same poses")
+                        help="instead: how often a Labyrinth or Two-colour agent acts alike on both engines' frames "
+                             "at the same poses")
     args = parser.parse_args()
     if args.agreement:
-        if paper_agents.get(args.agreement).scenario != "labyrinth":
-            raise SystemExit("error: --agreement takes a Labyrinth agent (labyrinth_7 .. labyrinth_13)")
+        scenario = paper_agents.get(args.agreement).scenario
+        if scenario not in ("labyrinth", "two_colour"):
+            raise SystemExit("error: --agreement takes a Labyrinth or Two-colour agent (labyrinth_7 .. two_colour_7)")
         print(f"{args.agreement}: the same action at {agreement(args.agreement, str(args.checkout)):.1%} of the "
               "poses of its ViZDoom episodes (first 8 test mazes)")
+        if scenario == "two_colour":
+            print(f"  with mjmaze's items hidden: {agreement(args.agreement, str(args.checkout), hide_items=True):.1%}")
         return
     names = args.only or list(paper_agents.AGENTS)
     for name in names:
