@@ -106,25 +106,46 @@ def test_the_exit_on_a_map_and_in_the_flat_style_is_its_mean_colour():
 @pytest.mark.parametrize("name, rgba, doom", [
     (two_colour.TOTEM.name, two_colour.GREEN, (24, 48, 17)),  # tall green column
     (two_colour.TOTEM.name, two_colour.RED, (69, 6, 4)),  # tall red column
-    (two_colour.ITEMS[0].name, two_colour.ITEM_GREEN, (46, 58, 36)),  # green armour
-    (two_colour.ITEMS[0].name, two_colour.ITEM_RED, (65, 28, 26)),  # Freedoom's "blue" armour, red
+    # The green armour's green chest, its mean 1-3 m ahead (tools/doom_frames.py --armour-parts).
+    (two_colour.ITEMS[0].name, two_colour.ITEM_GREEN, (37, 78, 28)),
 ])
 def test_two_colour_objects_2m_ahead_have_vizdooms_colours(name, rgba, doom):
+    assert object_2m_ahead(name, rgba) == pytest.approx(doom, abs=CLOSE)
+
+
+def test_two_colour_red_items_are_the_red_armours_body_as_red_as_gl_draws():
+    # ViZDoom draws the body at (121, 11, 11) (1-3 m ahead): mjmaze's red channel is at its limit.
+    assert two_colour.ITEM_RED[0] == 1.0
+    red, green, blue = object_2m_ahead(two_colour.ITEMS[1].name, two_colour.ITEM_RED)
+    assert (green, blue) == pytest.approx((11, 11), abs=CLOSE) and red > 80
+
+
+def test_two_colour_items_differ_more_than_the_whole_sprites_means():
+    # The sprites' means share the grey plates: the parts are what tell the two colours apart.
+    parts = np.subtract(two_colour.ITEM_GREEN[:3], two_colour.ITEM_RED[:3])
+    means = np.subtract(palette.GREEN_ARMOUR_RGBA[:3], palette.RED_ARMOUR_RGBA[:3])
+    assert np.linalg.norm(parts) > 2 * np.linalg.norm(means)
+
+
+def object_2m_ahead(name, rgba):
+    """Mean colour of object ``name`` in colour ``rgba``, 2 m ahead in the empty slime room."""
     env = empty_room(palette.SLIME_ROOM)
     physics = env.physics
     ids = physics.object_ids([name])
     physics.set_object_rgba(ids[1][0], rgba)
     physics.show_objects(ids[1], True)
     physics.place_objects(ids[0], np.array([[2.0, 0.0]]))
-    assert object_colour(env, name, (0.0, 0.0, 0.0)) == pytest.approx(doom, abs=CLOSE)
+    colour = object_colour(env, name, (0.0, 0.0, 0.0))
     env.task.close()
+    return colour
 
 
 def test_k_items_first_two_kinds_are_the_released_armours_as_vizdoom_draws_them():
     from mjmaze.tasks import k_item
 
     green, red = (geom for _, geom in k_item.KINDS[:2])
-    assert (green.rgba, red.rgba) == (two_colour.ITEM_GREEN, two_colour.ITEM_RED)
+    # The released armours' mean colours (K-item 2's released agent agrees with ViZDoom's on them).
+    assert (green.rgba, red.rgba) == (palette.GREEN_ARMOUR_RGBA, palette.RED_ARMOUR_RGBA)
     env = empty_room(palette.STONE_ROOM)  # K-item's room
     physics = env.physics
     ids = physics.object_ids([two_colour.ITEMS[0].name])

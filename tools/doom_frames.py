@@ -4,6 +4,7 @@
     python tools/doom_frames.py --calibrate  # colours of walls, floor, ceiling and objects, both engines
     python tools/doom_frames.py --flashes    # ViZDoom's red (hurt) and gold (pickup) flashes, tic by tic
     python tools/doom_frames.py --contrast   # how much Two-colour's items stand out, 1-4 m ahead
+    python tools/doom_frames.py --armour-parts  # the armours' coloured parts, 1-3 m ahead (Two-colour's items)
     python tools/doom_frames.py --two-colour RELEASED_REPO/scenarios/basefiles/two_color_basefile.wad
                                             # the released Two-colour script played: health changes, tics survived
 
@@ -331,6 +332,41 @@ def calibrate() -> None:
     env.task.close()
 
 
+def armour_parts() -> None:
+    """Prints the colour of the armours' coloured parts, 1 / 2 / 3 m ahead in the empty slime arena.
+
+    ViZDoom's frame at the released 320x180, over the blink cycle, the
+    armour's pixels (labels buffer) split by hue: the green armour's green
+    chest, Freedoom's "blue" armour's red body; the rest is their grey
+    plates and edges. Two-colour draws each item in its coloured part's
+    colour (``palette.GREEN_ARMOUR_PART_RGBA``, ``RED_ARMOUR_PART_RGBA``).
+    """
+    env = empty_arena("slime")
+    config = env.task.config
+    for label, doom_type, channel, margin in (("green armour, green part", GREEN_ARMOUR, 1, 10),
+                                              ("red armour, red part", BLUE_ARMOUR, 0, 30)):
+        results = []
+        for d in (1, 2, 3):
+            with tempfile.TemporaryDirectory() as folder:
+                wad = pathlib.Path(folder) / "maze.wad"
+                write_wad(wad, textmap(config, (0.0, 0.0, 0), [Thing(d * UNITS, 0.0, doom_type)], SLIME))
+                game = released_game(wad, weapon=False)
+                game.advance_action(RAISE_TICS)
+                pixels = []
+                for _ in range(ANIMATION_TICS):
+                    state = game.get_state()
+                    things = [label.value for label in state.labels if label.object_name != "DoomPlayer"]
+                    pixels.append(state.screen_buffer[np.isin(state.labels_buffer, things)].astype(np.float64))
+                    game.advance_action(1)
+                game.close()
+            pixels = np.concatenate(pixels)
+            others = np.delete(pixels, channel, axis=1).max(axis=1)
+            part = pixels[:, channel] > others + margin
+            results.append(f"{np.round(pixels[part].mean(axis=0)).astype(int).tolist()} ({part.mean():.0%} of its pixels)")
+        print(f"  {label}: " + "   ".join(results))
+    env.task.close()
+
+
 def item_contrast() -> None:
     """Prints how much Two-colour's items stand out, d metres ahead in the empty arena, both engines.
 
@@ -463,9 +499,12 @@ def main() -> None:
     parser.add_argument("--two-colour", type=pathlib.Path, metavar="BASEFILE_WAD",
                         help="play the released Two-colour script (two_color_basefile.wad of the released repo)")
     parser.add_argument("--contrast", action="store_true", help="print how much Two-colour's items stand out")
+    parser.add_argument("--armour-parts", action="store_true", help="print the armours' coloured parts, 1-3 m ahead")
     parser.add_argument("--episodes", type=int, default=32, help="episodes for --two-colour")
     args = parser.parse_args()
-    if args.contrast:
+    if args.armour_parts:
+        armour_parts()
+    elif args.contrast:
         item_contrast()
     elif args.two_colour:
         two_colour_script(args.two_colour, args.episodes)

@@ -36,6 +36,9 @@ Arguments
 Metric
     ``duration``: tics survived (max 2100); also ``health`` and ``totem_green``.
 Version History
+    * v1 (2026-11-25): items in their sprites' coloured parts (the green chest,
+      the red body) instead of the whole sprites' mean colour; the released
+      agent now survives 1,2xx instead of 780 test tics (ViZDoom: 1,400).
     * v0 (2026-11-23): initial release; frames, motion and rules calibrated
       against ViZDoom through 2026-11-24 under the same id (CHANGELOG.md).
 """
@@ -94,9 +97,10 @@ _CHUNK_ELEMENTS = 1 << 24
 # green column (things 32 / 30, 16 map units in radius and 52 high, as
 # Find-and-return's pillars); the items are Freedoom's green armour and its
 # "blue" armour, which Freedoom draws red (the released ACS calls it the red
-# armour), lying on the floor at their sprites' size; colours as ViZDoom draws them.
+# armour), lying on the floor at their sprites' size, each in the colour of
+# its sprite's coloured part as ViZDoom draws it (see palette.GREEN_ARMOUR_PART_RGBA).
 RED, GREEN = palette.TALL_RED_COLUMN_RGBA, palette.TALL_GREEN_COLUMN_RGBA
-ITEM_RED, ITEM_GREEN = palette.RED_ARMOUR_RGBA, palette.GREEN_ARMOUR_RGBA
+ITEM_RED, ITEM_GREEN = palette.RED_ARMOUR_PART_RGBA, palette.GREEN_ARMOUR_PART_RGBA
 TOTEM = mjcf.floor_thing("totem", "cylinder", 32, 52, RED, collides=True)
 TOTEM_RADIUS = TOTEM.size[0]
 # The agent's centre never comes closer to the totem's than this.
@@ -319,7 +323,7 @@ class TwoColour(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="two_colour",
     task=TwoColour,
-    gym_id="mjmaze/TwoColour-v0",
+    gym_id="mjmaze/TwoColour-v1",
     seed_code=4,
     difficulty="complexity",
     difficulties=COMPLEXITIES,
