@@ -38,7 +38,7 @@ Metric
 Version History
     * v1 (2026-11-25): items in their sprites' coloured parts (the green chest,
       the red body) instead of the whole sprites' mean colour; the released
-      agent now survives 1,2xx instead of 780 test tics (ViZDoom: 1,400).
+      agent survives 1,105 / 1,179 train / test tics, not 805 / 780 (ViZDoom: 1,485 / 1,400).
     * v0 (2026-11-23): initial release; frames, motion and rules calibrated
       against ViZDoom through 2026-11-24 under the same id (CHANGELOG.md).
 """
