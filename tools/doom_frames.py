@@ -161,9 +161,10 @@ def released_game(wad: pathlib.Path, weapon: bool = True, variables=(), buttons=
     return game
 
 
-def doom_tics(text: str, weapon: bool = True) -> tuple[np.ndarray, np.ndarray]:
+def doom_tics(text: str, weapon: bool = True, resize: bool = True) -> tuple[np.ndarray, np.ndarray]:
     """ViZDoom's 112x64 frames of map ``text``, one per tic of the armour's blink cycle, and per
-    frame the share of each pixel covered by things."""
+    frame the share of each pixel covered by things (``resize=False``: the released 320x180
+    frames and where things are drawn)."""
     with tempfile.TemporaryDirectory() as folder:
         wad = pathlib.Path(folder) / "maze.wad"
         write_wad(wad, text)
@@ -174,8 +175,9 @@ def doom_tics(text: str, weapon: bool = True) -> tuple[np.ndarray, np.ndarray]:
         for _ in range(ANIMATION_TICS):
             state = game.get_state()
             things = [label.value for label in state.labels if label.object_name != "DoomPlayer"]
-            screens.append(area_resize(state.screen_buffer))
-            masks.append(area_resize(np.isin(state.labels_buffer, things).astype(np.float64)))
+            drawn = np.isin(state.labels_buffer, things)
+            screens.append(area_resize(state.screen_buffer) if resize else state.screen_buffer)
+            masks.append(area_resize(drawn.astype(np.float64)) if resize else drawn)
             game.advance_action(1)
         game.close()
     return np.array(screens), np.array(masks)
@@ -347,19 +349,9 @@ def armour_parts() -> None:
                                               ("red armour, red part", BLUE_ARMOUR, 0, 30)):
         results = []
         for d in (1, 2, 3):
-            with tempfile.TemporaryDirectory() as folder:
-                wad = pathlib.Path(folder) / "maze.wad"
-                write_wad(wad, textmap(config, (0.0, 0.0, 0), [Thing(d * UNITS, 0.0, doom_type)], SLIME))
-                game = released_game(wad, weapon=False)
-                game.advance_action(RAISE_TICS)
-                pixels = []
-                for _ in range(ANIMATION_TICS):
-                    state = game.get_state()
-                    things = [label.value for label in state.labels if label.object_name != "DoomPlayer"]
-                    pixels.append(state.screen_buffer[np.isin(state.labels_buffer, things)].astype(np.float64))
-                    game.advance_action(1)
-                game.close()
-            pixels = np.concatenate(pixels)
+            screens, drawn = doom_tics(textmap(config, (0.0, 0.0, 0), [Thing(d * UNITS, 0.0, doom_type)], SLIME),
+                                       weapon=False, resize=False)
+            pixels = screens[drawn].astype(np.float64)
             others = np.delete(pixels, channel, axis=1).max(axis=1)
             part = pixels[:, channel] > others + margin
             results.append(f"{np.round(pixels[part].mean(axis=0)).astype(int).tolist()} ({part.mean():.0%} of its pixels)")

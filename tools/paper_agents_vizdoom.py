@@ -33,7 +33,7 @@ import pathlib
 import numpy as np
 import torch
 
-from mjmaze import files, suite
+from mjmaze import files, mjcf, rules, suite
 from mjmaze.train import paper_agents
 
 LIMITED_ACTIONS = ([True, False, False, False], [False, True, False, False], [False, False, True, False],
@@ -169,7 +169,7 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
                 logits, _, hidden = agent.step(agent.features(torch.from_numpy(_frame(game)[None])), hidden, start)
             start[:] = False
             action = int(logits.argmax())
-            path.append(((x - centre[0]) / 128, (y - centre[1]) / 128, math.radians(angle), action, things, tuple(flashes)))
+            path.append((*_metres(x, y, centre), math.radians(angle), action, things, tuple(flashes)))
             for _ in range(FRAME_SKIP):  # tic by tic, to follow the flash counters
                 game.make_action(LIMITED_ACTIONS[action], 1)
                 flashes = [max(count - 1, 0) for count in flashes]
@@ -177,9 +177,9 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
                     break
                 now = game.get_game_variable(vzd.GameVariable.HEALTH)
                 if now < health:
-                    flashes[0] = min(flashes[0] + int(health - now), 100)
+                    flashes[0] = min(flashes[0] + int(health - now), rules.MAX_DAMAGE_COUNT)
                 if now > health or now <= health - 12:  # an item: +25, or a wrong one's 13 or 17
-                    flashes[1] += 6
+                    flashes[1] += rules.BONUS_TICS
                 health = now
         game.close()
         env.reset()
@@ -200,10 +200,15 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
     return float(np.mean(same))
 
 
+def _metres(x: float, y: float, centre: np.ndarray) -> tuple[float, float]:
+    """A Doom map point in mjmaze's metres (mjmaze centres the maze on (0, 0))."""
+    return (x - centre[0]) * mjcf.MAP_UNIT, (y - centre[1]) * mjcf.MAP_UNIT
+
+
 def _two_colour_things(game, centre: np.ndarray) -> tuple[list, bool]:
     """ViZDoom's Two-colour items ``[(x, y, green)]`` in mjmaze's metres, and whether the totem is green."""
     objects = game.get_state().objects
-    items = [((o.position_x - centre[0]) / 128, (o.position_y - centre[1]) / 128, o.name == "GreenArmor")
+    items = [(*_metres(o.position_x, o.position_y, centre), o.name == "GreenArmor")
              for o in objects if o.name in ("GreenArmor", "BlueArmor")]
     # The script moves one of two columns parked 4,000 units away onto the totem's spot.
     totem = next(o for o in objects if o.name.endswith("Column") and abs(o.position_x - centre[0]) < 2000)
