@@ -9,7 +9,7 @@ in the default "textured" frames and in the "flat" ones:
   lean        the vector env's per-env step: MazeTask.advance (action -> physics -> rules), the
               render into a preallocated frame and the info dict, no dm_control TimeStep
   dm_control  env.step(action) of mjmaze.load("labyrinth"): action -> physics -> rules -> observation copy
-  gymnasium   env.step(action) of gymnasium.make("mjmaze/Labyrinth-v0") (through its default wrappers)
+  gymnasium   env.step(action) of gymnasium.make("mjmaze/Labyrinth-vN") (through its default wrappers)
 and the ratios full step / raw, textured / flat, plus a per-phase split of the full step.
 """
 
@@ -96,7 +96,7 @@ def bench_dm_control(size: int, steps: int, style: str) -> float:
 
 
 def bench_gymnasium(size: int, steps: int, style: str) -> float:
-    env = gymnasium.make("mjmaze/Labyrinth-v0", size=size, visual_style=style)
+    env = gymnasium.make(mjmaze.registry.get("labyrinth").gym_id, size=size, visual_style=style)
     actions = np.random.default_rng(0).integers(5, size=steps).tolist()
     env.reset(seed=0)
     start = time.perf_counter()
