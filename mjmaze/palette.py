@@ -50,8 +50,8 @@ RED_ARMOUR_RGBA = (0.73, 0.31, 0.30, 1.0)
 #: (docs/paper_agents.md); the olive mean also hid the exit from them.
 #: ViZDoom draws the green armour's green chest at (43, 90, 33), (31, 66, 23),
 #: (36, 77, 28) and the red armour's body at (122, 12, 12), (119, 9, 9),
-#: (123, 11, 11), 1 / 2 / 3 m ahead in the slime room
-#: (``python tools/doom_frames.py --armour-parts``); these give their mean
+#: (123, 11, 11), 1 / 2 / 3 m ahead in the slime room, the green the same in
+#: the stone room (``python tools/doom_frames.py --armour-parts``); these give their mean
 #: 2 m ahead in mjmaze. The red one at the renderer's limit (ViZDoom's is
 #: ~35% brighter than a red channel of 1 can draw).
 GREEN_ARMOUR_PART_RGBA = (0.42, 0.85, 0.30, 1.0)

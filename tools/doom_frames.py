@@ -243,7 +243,7 @@ def exit_figure() -> None:
     for distance in (1, 2, 3):
         row, col, angle = poses[distance]
         spawn = (*(c * UNITS for c in config.cell_centre((row, col))), angle)
-        doom, _ = doom_view(textmap(config, spawn, [Thing(exit_x, exit_y, GREEN_ARMOUR)]))
+        doom, _ = doom_view(textmap(config, spawn, [Thing(exit_x, exit_y, GREEN_ARMOUR)]), weapon=False)  # as released
         ours, _ = mjmaze_view(env, spawn, ["exit"])
         rows.append(np.concatenate([doom, np.full((SIZE[1], 4, 3), 255, np.uint8), ours], axis=1))
     env.task.close()
@@ -335,21 +335,25 @@ def calibrate() -> None:
 
 
 def armour_parts() -> None:
-    """Prints the colour of the armours' coloured parts, 1 / 2 / 3 m ahead in the empty slime arena.
+    """Prints the colour of the armours' coloured parts, 1 / 2 / 3 m ahead in an empty arena.
 
     ViZDoom's frame at the released 320x180, over the blink cycle, the
     armour's pixels (labels buffer) split by hue: the green armour's green
     chest, Freedoom's "blue" armour's red body; the rest is their grey
-    plates and edges. Two-colour draws each item in its coloured part's
-    colour (``palette.GREEN_ARMOUR_PART_RGBA``, ``RED_ARMOUR_PART_RGBA``).
+    plates and edges. Two-colour's items (slime room) and the Labyrinth exit
+    (the green armour, stone room) are drawn in their coloured part's colour
+    (``palette.GREEN_ARMOUR_PART_RGBA``, ``RED_ARMOUR_PART_RGBA``).
     """
     env = empty_arena("slime")
     config = env.task.config
-    for label, doom_type, channel, margin in (("green armour, green part", GREEN_ARMOUR, 1, 10),
-                                              ("red armour, red part", BLUE_ARMOUR, 0, 30)):
+    for label, doom_type, channel, margin, textures in (
+        ("green armour, green part, slime room", GREEN_ARMOUR, 1, 10, SLIME),
+        ("red armour, red part, slime room", BLUE_ARMOUR, 0, 30, SLIME),
+        ("green armour, green part, stone room", GREEN_ARMOUR, 1, 10, STONE),
+    ):
         results = []
         for d in (1, 2, 3):
-            screens, drawn = doom_tics(textmap(config, (0.0, 0.0, 0), [Thing(d * UNITS, 0.0, doom_type)], SLIME),
+            screens, drawn = doom_tics(textmap(config, (0.0, 0.0, 0), [Thing(d * UNITS, 0.0, doom_type)], textures),
                                        weapon=False, resize=False)
             pixels = screens[drawn].astype(np.float64)
             others = np.delete(pixels, channel, axis=1).max(axis=1)
