@@ -137,10 +137,6 @@ class MazePhysics(mujoco.Physics):
         """Shows (True) or hides (False) objects in the agent's view."""
         self.model.ptr.geom_group[geom_ids] = np.where(visible, VISIBLE_GROUP, render.HIDDEN_GROUP)
 
-    def set_object_collisions(self, geom_id: int, collides: bool) -> None:
-        """Makes an object that collides (a pillar, the totem) block the agent or not."""
-        self.model.ptr.geom_contype[geom_id] = self.model.ptr.geom_conaffinity[geom_id] = int(collides)
-
     def set_object_rgba(self, geom_id: int, rgba) -> None:
         self.model.ptr.geom_rgba[geom_id] = rgba
 

@@ -24,8 +24,7 @@ object sit in one mocap body at the origin; per world, a box of an absent wall
 or a hidden object is moved below the floor (``geom_pos``), the wall mesh is
 chosen among one mesh per wall layout (``geom_dataid``), and objects are
 coloured by ``geom_rgba``. An object that collides has a second, invisible
-geom for contacts, moved away where it must not block (Two-colour's totem
-while the agent stands inside it).
+geom for contacts, moved below the floor with it when it is hidden.
 
 Install with ``pip install "mjmaze[warp]"``; importing :mod:`mjmaze` never
 imports Warp or torch, only this module does.
@@ -338,7 +337,7 @@ class MazeBatchEnv(batch.BatchEnv):
             self._geom_rgba[:, self._object_ids] = torch.where(rows[:, :, None], start["object_rgba"].float(), rgba)
 
     def _place_objects(self, state: dict) -> None:
-        """Moves every world's objects where ``state`` says; hidden or non-blocking ones below the floor."""
+        """Moves every world's objects where ``state`` says; hidden ones below the floor."""
         shown = state["object_shown"]
         xy = torch.where(shown[..., None], state["object_xy"], 0.0).float()
         pos = self._geom_pos
@@ -346,11 +345,8 @@ class MazeBatchEnv(batch.BatchEnv):
         pos[:, ids, 0:2] = xy
         pos[:, ids, 2] = torch.where(shown, self._object_z, _AWAY_Z)
         if len(self._colliding):
-            blocks = shown[:, self._colliding]
-            if "object_collides" in state:
-                blocks = blocks & state["object_collides"][:, self._colliding]
             pos[:, self._collision_ids, 0:2] = xy[:, self._colliding]
-            pos[:, self._collision_ids, 2] = torch.where(blocks, self._object_z[self._colliding], _AWAY_Z)
+            pos[:, self._collision_ids, 2] = torch.where(shown[:, self._colliding], self._object_z[self._colliding], _AWAY_Z)
 
     def _show_state(self) -> None:
         """Moves every world's objects where the rule state says (once per step), then renders the observations."""

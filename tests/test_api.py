@@ -53,7 +53,7 @@ PAPER_TABLE = (
     [("mjmaze/Labyrinth-v3", {"size": n}) for n in labyrinth.SIZES]
     + [("mjmaze/FindReturn-v1", {"size": n}) for n in find_return.SIZES]
     + [("mjmaze/KItem-v1", {"num_items": k}) for k in k_item.PAPER_NUM_ITEMS]
-    + [("mjmaze/TwoColour-v1", {"complexity": c}) for c in two_colour.PAPER_COMPLEXITIES]
+    + [("mjmaze/TwoColour-v2", {"complexity": c}) for c in two_colour.PAPER_COMPLEXITIES]
 )
 
 
@@ -119,10 +119,11 @@ def test_an_old_id_names_the_current_one():
     for old in ("mjmaze/Labyrinth-v0", "mjmaze/Labyrinth-v2"):
         with pytest.raises(gymnasium.error.DeprecatedEnv, match="mjmaze/Labyrinth-v3"):
             gymnasium.make(old)
-    with pytest.raises(gymnasium.error.DeprecatedEnv, match="mjmaze/TwoColour-v1"):
-        gymnasium.make("mjmaze/TwoColour-v0")
+    for old in ("mjmaze/TwoColour-v0", "mjmaze/TwoColour-v1"):
+        with pytest.raises(gymnasium.error.DeprecatedEnv, match="mjmaze/TwoColour-v2"):
+            gymnasium.make(old)
     assert {mjmaze.registry.get(name).gym_id for name in mjmaze.ALL_TASKS} == {
-        "mjmaze/Labyrinth-v3", "mjmaze/FindReturn-v1", "mjmaze/KItem-v1", "mjmaze/TwoColour-v1"}
+        "mjmaze/Labyrinth-v3", "mjmaze/FindReturn-v1", "mjmaze/KItem-v1", "mjmaze/TwoColour-v2"}
 
 
 def test_bad_input_through_gymnasium():
@@ -155,7 +156,7 @@ def test_the_cpu_envs_import_neither_warp_nor_torch():
 
     code = (
         "import sys, gymnasium, mjmaze\n"
-        "env = gymnasium.make('mjmaze/TwoColour-v1'); env.reset(seed=0); env.step(0)\n"
+        "env = gymnasium.make('mjmaze/TwoColour-v2'); env.reset(seed=0); env.step(0)\n"
         "print(sorted(m for m in ('warp', 'mujoco_warp', 'torch') if m in sys.modules))\n"
     )
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)

@@ -217,21 +217,20 @@ def test_a_released_layout_without_interior_walls_imports_and_plays(tmp_path):
     assert env.step(FORWARD).reward > 0
 
 
-def test_a_released_spawn_in_the_totem_cell_plays_as_released(tmp_path):
+def test_a_released_spawn_on_the_totem_spot_has_no_totem_as_in_vizdoom(tmp_path):
+    # The released script moves a column onto the spot with SetActorPosition, which
+    # fails where the agent stands: ViZDoom shows no totem all episode (measured).
     wall = [-512.0, -256.0, -256.0, -256.0]  # one interior wall, away from the centre
     (tmp_path / "two_color_maze001.json").write_text(json.dumps(released_two_colour([wall], (2, 2))))
     env = load("two_colour", layouts=str(tmp_path), item_cap=0)
     assert env.task.config.spawn_cell == env.task.config.object_cells[0] == (2, 2)
     x, y, yaw = env.physics.agent_pose()
-    assert (x, y, yaw) == (0.0, 0.0, 0.0)  # inside the totem, facing +x
-    for _ in range(4):
-        env.step(FORWARD)
-    x, _, _ = env.physics.agent_pose()
-    assert x == pytest.approx((7.1 + 15.6 + 21.4 + 25.3) / 128, abs=0.01)  # walked out of it freely, as from rest in the open
-    for _ in range(12):  # turn round (180 degrees) and walk back: now it blocks
-        env.step(TURN_LEFT)
-    path = push(env, FORWARD, 8)
-    assert np.hypot(*path.T).min() >= two_colour.TOTEM_CLEARANCE - TOLERANCE
+    assert (x, y, yaw) == (0.0, 0.0, 0.0)  # on the totem's spot, facing +x
+    place(env, 1.0, 0.0, math.pi)  # 1 m off, facing the spot: nothing there to see
+    totem = env.physics.object_ids([two_colour.TOTEM.name])[1]
+    assert not np.isin(env.task.segmentation(env.physics), totem).any()
+    path = push(env, FORWARD, 8)  # nor to bump into: the agent walks over the spot
+    assert np.hypot(*path.T).min() < 0.05
 
 
 def test_other_scenarios_still_refuse_a_spawn_on_an_object(tmp_path):

@@ -49,6 +49,19 @@ def test_walls_are_as_dim_as_vizdooms_and_brighter_near_the_eye():
     env.task.close()
 
 
+def test_two_colour_walls_are_the_released_grey_stone2():
+    # The released generator writes every side STONE2, replacing its base map's green-grey
+    # GSTONE1: a Two-colour wall is as grey as Labyrinth's (ViZDoom: 38 grey 1 m ahead).
+    env = mjmaze.load("two_colour", task_kwargs={"complexity": 0, "random": 0})
+    env.reset()
+    env.physics.show_objects(env.physics.object_ids([o.name for o in env.task.objects])[1], False)
+    face = env.task.config.size * env.task.config.cell_size / 2 - walls.WALL_THICKNESS / 2
+    red, green, blue = frame_at(env, face - 1.0, 0.0, 0.0)[24:32, 50:62].reshape(-1, 3).mean(axis=0)
+    env.task.close()
+    assert (red, green, blue) == pytest.approx((38, 38, 38), abs=CLOSE)
+    assert max(red, green, blue) - min(red, green, blue) < 4  # grey, not green-grey
+
+
 @pytest.mark.parametrize("room, floor, ceiling", [
     (palette.STONE_ROOM, (48, 35, 18), (34, 34, 34)),  # FLAT1_1 brown, MFLR8_1 grey
     (palette.SLIME_ROOM, (18, 35, 10), (0, 0, 17)),  # NUKAGE1 green, CEIL4_1 dark blue

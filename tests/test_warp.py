@@ -156,9 +156,9 @@ def test_flashes_tint_every_world_as_the_cpu_task():
         assert torch.equal(obs, obs_plain) == (damage == 0), step
 
 
-def test_a_released_layout_that_spawns_inside_the_totem(tmp_path):
+def test_a_released_layout_that_spawns_on_the_totem_spot(tmp_path):
     # The released Two-colour generator could put the spawn in the totem's cell:
-    # the totem blocks only once the agent has stepped clear (its collision twin in Warp).
+    # that episode has no totem, nothing to see or to bump into (its collision twin in Warp).
     config = mjmaze.load("two_colour", task_kwargs={"complexity": 1}).task.configs[0]
     centre = [v * 128 for v in config.cell_centre(config.object_cells[0])]
     half = config.size * config.cell_size / 2 * 128

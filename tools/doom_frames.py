@@ -43,7 +43,7 @@ ANIMATION_TICS = 13  # Doom's armour sprites: ARM1 A 6 tics, B (bright) 7
 RAISE_TICS = 8  # the pistol is still being raised for ~6 tics after the released start (tic 10)
 # Doom textures of the released rooms: (walls, floor, ceiling).
 STONE = ("STONE2", "FLAT1_1", "MFLR8_1")  # Labyrinth, Find-and-return, K-item
-SLIME = ("GSTONE1", "NUKAGE1", "CEIL4_1")  # Two-colour
+SLIME = ("STONE2", "NUKAGE1", "CEIL4_1")  # Two-colour: its generator writes STONE2 sides (the base map's GSTONE1 goes)
 GREEN_ARMOUR, BLUE_ARMOUR, GREEN_COLUMN, RED_COLUMN = 2018, 2019, 30, 32
 LAVA_HEFTY = 83  # the sector special the released Two-colour generator writes (create_sector_toxic)
 # K-item's things in collection order, as the released generator places them (docs/objects.md).

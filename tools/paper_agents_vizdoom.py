@@ -205,14 +205,15 @@ def _metres(x: float, y: float, centre: np.ndarray) -> tuple[float, float]:
     return (x - centre[0]) * mjcf.MAP_UNIT, (y - centre[1]) * mjcf.MAP_UNIT
 
 
-def _two_colour_things(game, centre: np.ndarray) -> tuple[list, bool]:
-    """ViZDoom's Two-colour items ``[(x, y, green)]`` in mjmaze's metres, and whether the totem is green."""
+def _two_colour_things(game, centre: np.ndarray) -> tuple[list, bool | None]:
+    """ViZDoom's Two-colour items ``[(x, y, green)]`` in mjmaze's metres, and whether the totem is green (None: no totem)."""
     objects = game.get_state().objects
     items = [(*_metres(o.position_x, o.position_y, centre), o.name == "GreenArmor")
              for o in objects if o.name in ("GreenArmor", "BlueArmor")]
-    # The script moves one of two columns parked 4,000 units away onto the totem's spot.
-    totem = next(o for o in objects if o.name.endswith("Column") and abs(o.position_x - centre[0]) < 2000)
-    return items, "Green" in totem.name
+    # The script moves one of two columns parked 4,000 units away onto the totem's spot
+    # (neither, where the agent stands on it).
+    totem = next((o for o in objects if o.name.endswith("Column") and abs(o.position_x - centre[0]) < 2000), None)
+    return items, None if totem is None else "Green" in totem.name
 
 
 def _place_two_colour_things(task, physics, things: tuple[list, bool], flashes: tuple[int, int], hide: bool) -> None:
@@ -221,8 +222,10 @@ def _place_two_colour_things(task, physics, things: tuple[list, bool], flashes: 
 
     items, totem_green = things
     state, row = task.state, task.row
-    state["totem_green"][row] = totem_green
-    state["object_rgba"][row, 0] = two_colour.TOTEM_COLOURS[int(totem_green)]
+    state["object_shown"][row, 0] = totem_green is not None
+    if totem_green is not None:
+        state["totem_green"][row] = totem_green
+        state["object_rgba"][row, 0] = two_colour.TOTEM_COLOURS[int(totem_green)]
     shown, xy, used = np.zeros(two_colour.POOL_SIZE, dtype=bool), np.zeros((two_colour.POOL_SIZE, 2)), [0, 0]
     for x, y, green in items:
         slot = 2 * used[0] if green else 2 * used[1] + 1  # green items are the even slots

@@ -127,7 +127,6 @@ class MazeTask(core.MazeRules, base.Task):
         if everything:
             self._xy_in_model = np.full_like(xy, np.nan)
             self._shown_in_model = ~shown
-            self._collides_in_model = np.ones(len(ids), dtype=bool)
             if "object_rgba" in state:
                 for geom, rgba in zip(ids, state["object_rgba"][row]):
                     physics.set_object_rgba(geom, rgba)
@@ -139,11 +138,6 @@ class MazeTask(core.MazeRules, base.Task):
         if len(flipped):
             physics.show_objects(ids[flipped], shown[flipped])
             self._shown_in_model = shown.copy()
-        if "object_collides" in state:
-            collides = state["object_collides"][row]
-            for k in np.flatnonzero(collides != self._collides_in_model):
-                physics.set_object_collisions(ids[k], bool(collides[k]))
-            self._collides_in_model = collides.copy()
 
     # -- the per-step path ------------------------------------------------
 

@@ -31,11 +31,15 @@ Arguments
     released) and the common task arguments. The spawn heading is fixed at 0
     (facing +x), as released. Generated mazes never spawn the agent in the
     totem's cell; the released generator could, and such an imported layout
-    plays as released: the agent starts inside the totem, which does not block
-    it until it has stepped clear (as ZDoom lets overlapping actors move apart).
+    plays as released: the script cannot move a column onto the spot the agent
+    stands on, so that episode has no totem (the items keep their rules).
 Metric
     ``duration``: tics survived (max 2100); also ``health`` and ``totem_green``.
 Version History
+    * v2 (2026-11-25): grey ``STONE2`` walls, as the released generator writes
+      them (``-v1`` drew its base map's green-grey ``GSTONE1``); an imported
+      layout that spawns the agent on the totem's spot has no totem, as in
+      ViZDoom (it had one the agent started inside).
     * v1 (2026-11-25): items in their sprites' coloured parts (the green chest,
       the red body) instead of the whole sprites' mean colour; the released
       agent survives 1,105 / 1,179 train / test tics, not 805 / 780 (ViZDoom: 1,485 / 1,400).
@@ -105,6 +109,9 @@ TOTEM = mjcf.floor_thing("totem", "cylinder", 32, 52, RED, collides=True)
 TOTEM_RADIUS = TOTEM.size[0]
 # The agent's centre never comes closer to the totem's than this.
 TOTEM_CLEARANCE = TOTEM_RADIUS + core.AGENT_RADIUS
+# Where the released map keeps the columns until its script moves one in
+# (4,096 map units west of the centre), and an absent totem stays.
+TOTEM_PARKED_XY = (-4096 * mjcf.MAP_UNIT, 0.0)
 ITEMS = tuple(mjcf.floor_thing(f"item_{k}", "cylinder", 31, 17, ITEM_RED) for k in range(POOL_SIZE))
 TOTEM_COLOURS = (tuple(RED), tuple(GREEN))  # by totem_green
 ITEM_COLOURS = tuple(tuple(ITEM_GREEN if k % 2 == 0 else ITEM_RED) for k in range(POOL_SIZE))
@@ -156,19 +163,16 @@ class TwoColour(core.MazeRules):
         rgba = rules.constant(xp, TOTEM_COLOURS, xp.float64, device)
         # Items alternate colours, green first; the totem's is drawn per episode.
         item_rgba = xp.broadcast_to(rules.constant(xp, ITEM_COLOURS, xp.float64, device)[None], (batch, POOL_SIZE, 4))
-        inside_totem = xp.sum((spawn_xy - totem_xy) ** 2, axis=1) < TOTEM_CLEARANCE**2
+        # An imported layout may spawn the agent on the totem's spot: the
+        # released script's SetActorPosition then fails and both columns stay
+        # parked outside the map, so the episode has no totem (measured in ViZDoom).
+        no_totem = xp.sum((spawn_xy - totem_xy) ** 2, axis=1) < TOTEM_CLEARANCE**2
+        totem_xy = xp.where(no_totem[:, None], rules.constant(xp, TOTEM_PARKED_XY, xp.float64, device), totem_xy)
         state = {
             "pose": xp.concat([spawn_xy, xp.zeros((batch, 1), dtype=xp.float64, device=device)], axis=1),
             "object_xy": xp.concat([totem_xy[:, None], xp.zeros((batch, POOL_SIZE, 2), dtype=xp.float64, device=device)], axis=1),
-            "object_shown": xp.concat(
-                [xp.ones((batch, 1), dtype=xp.bool, device=device), xp.zeros((batch, POOL_SIZE), dtype=xp.bool, device=device)], axis=1
-            ),
+            "object_shown": xp.concat([~no_totem[:, None], xp.zeros((batch, POOL_SIZE), dtype=xp.bool, device=device)], axis=1),
             "object_rgba": xp.concat([rgba[xp.astype(totem_green, xp.int64)][:, None], item_rgba], axis=1),
-            # The agent may start inside the totem (imported layouts): it does
-            # not block the agent until the agent has stepped clear of it.
-            "object_collides": xp.concat(
-                [~inside_totem[:, None], xp.zeros((batch, POOL_SIZE), dtype=xp.bool, device=device)], axis=1
-            ),
             "walls": config["walls"],
             "totem_green": totem_green,
             "health": xp.full(batch, START_HEALTH, dtype=xp.int64, device=device),
@@ -225,11 +229,6 @@ class TwoColour(core.MazeRules):
         dead = health <= 0
         state["health"] = health
         shown = xp.concat([shown[:, :1], shown[:, 1:] & ~picked], axis=1)
-        # An agent that started inside the totem and stepped clear of it: the totem blocks from now on.
-        agent_xy = path[:, -1]
-        clear = xp.sum((agent_xy - state["object_xy"][:, 0]) ** 2, axis=1) >= TOTEM_CLEARANCE**2
-        collides = state["object_collides"]
-        state["object_collides"] = xp.concat([collides[:, :1] | (clear & ~dead)[:, None], collides[:, 1:]], axis=1)
         # One item every 30 tics (never more than one per 4-tic step after the start).
         due = rules.at_most(xp, 2 * START_ITEMS_PER_COLOUR + state["steps"] * core.TICS_PER_STEP // SPAWN_EVERY_TICS, self._item_cap)
         spawn = ~dead & (state["items_spawned"] < due)
@@ -237,7 +236,7 @@ class TwoColour(core.MazeRules):
         # for every env and keep the spawns (asking whether any is due would wait for the GPU).
         if not rules.on_host(xp) or bool(xp.any(spawn)):
             item = state["items_spawned"]
-            xy, drawn = self._free_positions(xp, state, state["key"], item[:, None], agent_xy)
+            xy, drawn = self._free_positions(xp, state, state["key"], item[:, None], path[:, -1])
             slot = rules.one_hot(xp, item + 1, 1 + POOL_SIZE) & (spawn & drawn[:, 0])[:, None]
             state["object_xy"] = xp.where(slot[:, :, None], xy, state["object_xy"])
             shown = shown | slot
@@ -323,7 +322,7 @@ class TwoColour(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="two_colour",
     task=TwoColour,
-    gym_id="mjmaze/TwoColour-v1",
+    gym_id="mjmaze/TwoColour-v2",
     seed_code=4,
     difficulty="complexity",
     difficulties=COMPLEXITIES,
