@@ -139,3 +139,28 @@ def test_curves_draw_a_paper_agents_level_beside_runs(released, tmp_path):
     saved = json.loads((tmp_path / "runs" / "paper" / "find_return_7" / "eval.json").read_text())
     assert group["released"] == {split: saved[split]["curve_value"] for split in ("train", "test")}
     assert (tmp_path / "c.png").stat().st_size > 1000
+
+
+def test_the_table_plays_again_an_evaluation_made_with_an_older_env_version(monkeypatch, tmp_path):
+    from mjmaze import registry
+    from mjmaze.train import paper_table
+
+    monkeypatch.chdir(tmp_path)
+    played = []
+
+    def play(source, **kwargs):
+        played.append(source)
+        return {"env_id": registry.get("two_colour").gym_id, "units": "tics survived",
+                "train": {"value": 1.0}, "test": {"value": 1.0}}
+
+    monkeypatch.setattr(evaluate, "evaluate", play)
+    out = evaluate.default_output("paper:two_colour_1")
+    out.parent.mkdir(parents=True)
+    out.write_text(json.dumps({"env_id": "mjmaze/TwoColour-v0", "train": {"value": 0.0}, "test": {"value": 0.0}}))
+    # Made with an older version of the scenario: not that scenario's result any more.
+    assert paper_table.evaluate_all(["two_colour_1"])["two_colour_1"]["train"]["value"] == 1.0
+    assert played == ["paper:two_colour_1"]
+    # Made with the current one: reused as it is.
+    out.write_text(json.dumps(play("paper:two_colour_1")))
+    paper_table.evaluate_all(["two_colour_1"])
+    assert len(played) == 2  # the call above, not a third play

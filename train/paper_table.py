@@ -7,8 +7,8 @@
 Each released agent (``mjmaze.train.paper_agents``) plays its setting's released
 mazes in mjmaze, greedily, as ``mjmaze.train.evaluate`` plays a run (the first
 64 training mazes and the 64 test mazes, each twice): written to
-``runs/paper/<setting>/eval.json`` and reused on the next call (``--redo``
-plays again). The table puts three numbers per split side by side, in the
+``runs/paper/<setting>/eval.json`` and reused on the next call if made with
+the scenario's current env id (``--redo`` plays again). The table puts three numbers per split side by side, in the
 paper's units: Table 2 (three agents trained from scratch, mean +- std), the
 released agent in ViZDoom (where ``--vizdoom`` has it), the released agent in
 mjmaze. The same agent, protocol and mazes in both engines make the last two
@@ -40,8 +40,11 @@ def evaluate_all(names: list[str], num_envs: int = 16, redo: bool = False,
     results = {}
     for name in names:
         out = evaluate.default_output(paper_agents.PREFIX + name)
-        if out.exists() and not redo:
-            results[name] = json.loads(out.read_text())
+        current = registry.get(paper_agents.get(name).scenario).gym_id
+        # Reused only if made with today's env version: a result must be of the scenario as it is.
+        earlier = json.loads(out.read_text()) if out.exists() and not redo else None
+        if earlier is not None and earlier.get("env_id") == current:
+            results[name] = earlier
             continue
         results[name] = evaluate.evaluate(paper_agents.PREFIX + name, num_envs=num_envs, out=out,
                                           torch_threads=torch_threads)
