@@ -26,6 +26,7 @@ from mjmaze import palette, walls
 VISUAL_STYLES = ("textured", "flat")
 
 
+BAND_TEXELS = 100  # texture rows for an object's bands (their shares are in hundredths)
 #: Side of the floor's quads: lighting is computed at their
 #: corners. With 1 m quads the floor under the eye flashed 2.5x brighter each
 #: time the agent passed a corner; 0.5 m keeps it within ~15% and costs ~30 us
@@ -54,6 +55,12 @@ class ObjectGeom:
     placed by writing ``model.geom_pos``: a body each made every ``mj_step``
     about twice as dear with Two-colour's 90 items (43 against 21 us per 4 tics).
     ``z`` is the height of the geom's centre. Objects start hidden.
+
+    ``bands`` (textured style only): the sprite's pixels from top to bottom as
+    ``(share, rgb)`` bands, drawn as a texture on the side of a cylinder, scaled
+    so that their mean is ``rgba`` (the calibrated mean colour, which maps and
+    the flat style show). Bands vary only with height: a cylinder shows the same
+    side from every direction, as a sprite, where a left-right pattern would turn.
     """
 
     name: str
@@ -62,6 +69,21 @@ class ObjectGeom:
     rgba: tuple[float, float, float, float]
     z: float
     collides: bool = False
+    bands: tuple[tuple[float, tuple[float, float, float]], ...] = ()
+
+    def band_texels(self) -> tuple[np.ndarray, float]:
+        """``(texels (BAND_TEXELS, 1, 3) uint8, gain)``: the bands as texture rows
+        relative to their mean, and the factor on ``rgba`` that keeps texels <= 1."""
+        shares = np.array([share for share, _ in self.bands])
+        colours = np.array([rgb for _, rgb in self.bands])
+        if abs(shares.sum() - 1) > 1e-6:
+            raise ValueError(f"{self.name}: band shares must sum to 1, got {shares.sum()}")
+        relative = colours / (shares @ colours)
+        gain = float(relative.max())
+        rows = np.repeat(np.arange(len(shares)), np.round(shares * BAND_TEXELS).astype(int))[:BAND_TEXELS]
+        rows = np.concatenate([rows, np.full(BAND_TEXELS - len(rows), len(shares) - 1)])
+        texels = np.round(relative[rows] / gain * 255).astype(np.uint8)
+        return texels[:, None, :], gain
 
 
 def floor_thing(name: str, shape: str, width: float, height: float, rgba, collides: bool = False) -> ObjectGeom:
@@ -166,7 +188,18 @@ def build_xml(
         )
     colliding = []  # batch: (object, attributes) of the colliding objects, placed after the others
     for obj in objects:  # see ObjectGeom
-        attrs = dict(name=obj.name, type=obj.type, size=" ".join(map(str, obj.size)), rgba=" ".join(map(str, obj.rgba)))
+        rgba = obj.rgba
+        attrs = dict(name=obj.name, type=obj.type, size=" ".join(map(str, obj.size)))
+        if obj.bands and visual_style == "textured":
+            # GL multiplies the texels by the geom's colour (a geom colour other
+            # than the default overrides the material's, in MuJoCo and MuJoCo Warp).
+            texels, gain = obj.band_texels()
+            ET.SubElement(asset, "texture", name=obj.name, type="2d", builtin="flat",
+                          width=str(texels.shape[1]), height=str(texels.shape[0]), rgb1="1 1 1")
+            ET.SubElement(asset, "material", name=obj.name, texture=obj.name, specular="0", shininess="0", reflectance="0")
+            attrs["material"] = obj.name
+            rgba = (*np.minimum(np.array(obj.rgba[:3]) * gain, 1.0).round(4).tolist(), obj.rgba[3])
+        attrs["rgba"] = " ".join(map(str, rgba))
         if batch and obj.collides:
             colliding.append((obj, attrs))
         elif batch:
@@ -232,9 +265,11 @@ def add_distance_falloff(root: ET.Element) -> None:
     )
 
 
-def paint_textures(model: mujoco.MjModel) -> None:
-    """Fills the wall and floor textures of a ``"textured"`` model (a fixed pattern, the same everywhere)."""
-    for name, texels in (("wall", palette.brick_texels()), ("floor", palette.tile_texels())):
+def paint_textures(model: mujoco.MjModel, objects: Sequence[ObjectGeom] = ()) -> None:
+    """Fills the textures of a ``"textured"`` model: walls and floor (a fixed
+    pattern, the same everywhere) and the bands of ``objects`` that have them."""
+    banded = [(obj.name, obj.band_texels()[0]) for obj in objects if obj.bands]
+    for name, texels in (("wall", palette.brick_texels()), ("floor", palette.tile_texels()), *banded):
         texture = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXTURE, name)
         if texture < 0:
             continue

@@ -2,7 +2,7 @@
 
 Every number here was measured in ViZDoom against mjmaze's frames
 (``python tools/doom_frames.py --calibrate``; docs/look.md): the rooms' mean
-colours, the things' colours and the armours' coloured parts, the light that fades
+colours, the things' colours, the armour sprite's bands, the light that fades
 with distance, and the grey texture patterns with the gains that keep each
 surface's mean colour. :mod:`mjmaze.mjcf` writes them into the arena.
 """
@@ -46,19 +46,29 @@ TALL_RED_COLUMN_RGBA = (0.73, 0.06, 0.04, 1.0)
 #: red items), averaged over their blink, on a floor cylinder of their size.
 GREEN_ARMOUR_RGBA = (0.52, 0.63, 0.39, 1.0)
 RED_ARMOUR_RGBA = (0.73, 0.31, 0.30, 1.0)
-#: The armours' coloured parts, Two-colour's items and the Labyrinth exit: one
-#: colour on a cylinder cannot show a sprite's two parts, and the mean above
-#: mixes in the grey plates both armours share, so green and red items looked
-#: more alike than ViZDoom's and the released agents picked 30-50% fewer
-#: (docs/paper_agents.md); the olive mean also hid the exit from them.
+#: The armours' coloured parts, Two-colour's items: one colour on a cylinder
+#: cannot show a sprite's two parts, and the mean above mixes in the grey
+#: plates both armours share, so green and red items looked more alike than
+#: ViZDoom's and the released agent picked 30-50% fewer (docs/paper_agents.md).
 #: ViZDoom draws the green armour's green chest at (43, 90, 33), (31, 66, 23),
 #: (36, 77, 28) and the red armour's body at (122, 12, 12), (119, 9, 9),
-#: (123, 11, 11), 1 / 2 / 3 m ahead in the slime room, the green the same in
-#: the stone room (``python tools/doom_frames.py --armour-parts``); these give their mean
+#: (123, 11, 11), 1 / 2 / 3 m ahead in the slime room
+#: (``python tools/doom_frames.py --armour-parts``); these give their mean
 #: 2 m ahead in mjmaze. The red one at the renderer's limit (ViZDoom's is
 #: ~35% brighter than a red channel of 1 can draw).
 GREEN_ARMOUR_PART_RGBA = (0.42, 0.85, 0.30, 1.0)
 RED_ARMOUR_PART_RGBA = (1.0, 0.12, 0.12, 1.0)
+#: The green armour's sprite (Freedoom's ARM1, 542 pixels) read from top to
+#: bottom as ``(share of its pixels, their mean colour)``: the grey shoulder
+#: plates, the green chest, the dark lower edge. ViZDoom's frames of the
+#: released maps show it so (51% grey, 26% vivid green: docs/paper_agents.md);
+#: drawn as horizontal bands on the object's side (:attr:`ObjectGeom.bands`),
+#: the olive mean alone hid the vivid part agents look for.
+GREEN_ARMOUR_BANDS = (
+    (0.52, (0.308, 0.297, 0.281)),
+    (0.28, (0.199, 0.422, 0.158)),
+    (0.20, (0.157, 0.136, 0.074)),
+)
 #: Ambient light everywhere, then a lamp at the eye adding ``LAMP_DIFFUSE x cos / (0.05 + d)``
 #: at ``d`` metres: Doom's light diminishing at sector light 160, which ViZDoom
 #: draws as 27 + 12 / d grey levels on a ``STONE2`` wall ``d`` map cells ahead.

@@ -335,25 +335,21 @@ def calibrate() -> None:
 
 
 def armour_parts() -> None:
-    """Prints the colour of the armours' coloured parts, 1 / 2 / 3 m ahead in an empty arena.
+    """Prints the colour of the armours' coloured parts, 1 / 2 / 3 m ahead in the empty slime arena.
 
     ViZDoom's frame at the released 320x180, over the blink cycle, the
     armour's pixels (labels buffer) split by hue: the green armour's green
     chest, Freedoom's "blue" armour's red body; the rest is their grey
-    plates and edges. Two-colour's items (slime room) and the Labyrinth exit
-    (the green armour, stone room) are drawn in their coloured part's colour
-    (``palette.GREEN_ARMOUR_PART_RGBA``, ``RED_ARMOUR_PART_RGBA``).
+    plates and edges. Two-colour draws each item in its coloured part's
+    colour (``palette.GREEN_ARMOUR_PART_RGBA``, ``RED_ARMOUR_PART_RGBA``).
     """
     env = empty_arena("slime")
     config = env.task.config
-    for label, doom_type, channel, margin, textures in (
-        ("green armour, green part, slime room", GREEN_ARMOUR, 1, 10, SLIME),
-        ("red armour, red part, slime room", BLUE_ARMOUR, 0, 30, SLIME),
-        ("green armour, green part, stone room", GREEN_ARMOUR, 1, 10, STONE),
-    ):
+    for label, doom_type, channel, margin in (("green armour, green part", GREEN_ARMOUR, 1, 10),
+                                              ("red armour, red part", BLUE_ARMOUR, 0, 30)):
         results = []
         for d in (1, 2, 3):
-            screens, drawn = doom_tics(textmap(config, (0.0, 0.0, 0), [Thing(d * UNITS, 0.0, doom_type)], textures),
+            screens, drawn = doom_tics(textmap(config, (0.0, 0.0, 0), [Thing(d * UNITS, 0.0, doom_type)], SLIME),
                                        weapon=False, resize=False)
             pixels = screens[drawn].astype(np.float64)
             others = np.delete(pixels, channel, axis=1).max(axis=1)

@@ -16,10 +16,6 @@ Arguments
 Metric
     ``success``: whether the exit was reached (success rate = mean over episodes).
 Version History
-    * v3 (2026-11-25): the exit is one colour, the green armour's green chest
-      as ViZDoom draws it (Two-colour's green item): with it the released
-      agents' success and episode lengths came within 10 points of ViZDoom's
-      on every size (docs/paper_agents.md).
     * v2 (2026-11-25): the exit shows the green armour's sprite as bands (grey
       plates, the vivid green chest, a dark lower edge) around the same mean
       colour; the released agents' episodes were longest where the olive
@@ -46,13 +42,13 @@ STEP_REWARD = -0.0001 * core.TICS_PER_STEP
 # on the floor, 40 x 16 map units (a 31 x 17 sprite), i.e. 0.12 m in radius and
 # 0.125 m high. A cylinder shows the same width from every side, as a sprite.
 # How small it is decides how far off the agent can spot it (docs/objects.md).
-# It shows the sprite's green chest, the part agents look for: the sprite's
-# mean (a dull olive, half of it the grey plates) and the sprite's parts as
-# bands both left the released agents lost where ViZDoom's found the exit
-# (docs/paper_agents.md).
+# Its mean colour is the armour's as ViZDoom draws it, blinking, at the
+# released light, a dull olive (docs/look.md); its side shows the sprite's
+# grey plates, vivid green chest and dark edge as bands around that mean.
 EXIT_RADIUS, EXIT_HEIGHT = 0.12, 16 * mjcf.MAP_UNIT
 EXIT = mjcf.ObjectGeom(
-    "exit", "cylinder", (EXIT_RADIUS, EXIT_HEIGHT / 2), palette.GREEN_ARMOUR_PART_RGBA, z=EXIT_HEIGHT / 2,
+    "exit", "cylinder", (EXIT_RADIUS, EXIT_HEIGHT / 2), palette.GREEN_ARMOUR_RGBA, z=EXIT_HEIGHT / 2,
+    bands=palette.GREEN_ARMOUR_BANDS,
 )
 
 
@@ -88,7 +84,7 @@ class Labyrinth(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="labyrinth",
     task=Labyrinth,
-    gym_id="mjmaze/Labyrinth-v3",
+    gym_id="mjmaze/Labyrinth-v2",
     seed_code=1,
     difficulty="size",
     difficulties=SIZES,
