@@ -346,7 +346,8 @@ class MazeBatchEnv(batch.BatchEnv):
         pos[:, ids, 2] = torch.where(shown, self._object_z, _AWAY_Z)
         if len(self._colliding):
             pos[:, self._collision_ids, 0:2] = xy[:, self._colliding]
-            pos[:, self._collision_ids, 2] = torch.where(shown[:, self._colliding], self._object_z[self._colliding], _AWAY_Z)
+            blocks = shown[:, self._colliding]
+            pos[:, self._collision_ids, 2] = torch.where(blocks, self._object_z[self._colliding], _AWAY_Z)
 
     def _show_state(self) -> None:
         """Moves every world's objects where the rule state says (once per step), then renders the observations."""

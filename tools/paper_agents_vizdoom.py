@@ -206,7 +206,10 @@ def _metres(x: float, y: float, centre: np.ndarray) -> tuple[float, float]:
 
 
 def _two_colour_things(game, centre: np.ndarray) -> tuple[list, bool | None]:
-    """ViZDoom's Two-colour items ``[(x, y, green)]`` in mjmaze's metres, and whether the totem is green (None: no totem)."""
+    """ViZDoom's Two-colour items ``[(x, y, green)]`` in mjmaze's metres, and whether the totem is green.
+
+    ``None`` where the map has no totem (the script could not move a column onto the spot).
+    """
     objects = game.get_state().objects
     items = [(*_metres(o.position_x, o.position_y, centre), o.name == "GreenArmor")
              for o in objects if o.name in ("GreenArmor", "BlueArmor")]
@@ -216,7 +219,8 @@ def _two_colour_things(game, centre: np.ndarray) -> tuple[list, bool | None]:
     return items, None if totem is None else "Green" in totem.name
 
 
-def _place_two_colour_things(task, physics, things: tuple[list, bool], flashes: tuple[int, int], hide: bool) -> None:
+def _place_two_colour_things(task, physics, things: tuple[list, bool | None], flashes: tuple[int, int],
+                             hide: bool) -> None:
     """Sets mjmaze's Two-colour episode to ViZDoom's things and flash counters (items of a colour fill its slots in turn)."""
     from mjmaze.tasks import two_colour
 

@@ -8,10 +8,10 @@ Each released agent (``mjmaze.train.paper_agents``) plays its setting's released
 mazes in mjmaze, greedily, as ``mjmaze.train.evaluate`` plays a run (the first
 64 training mazes and the 64 test mazes, each twice): written to
 ``runs/paper/<setting>/eval.json`` and reused on the next call if made with
-the scenario's current env id (``--redo`` plays again). The table puts three numbers per split side by side, in the
-paper's units: Table 2 (three agents trained from scratch, mean +- std), the
-released agent in ViZDoom (where ``--vizdoom`` has it), the released agent in
-mjmaze. The same agent, protocol and mazes in both engines make the last two
+the scenario's current env id (``--redo`` plays again). The table puts three
+numbers per split side by side, in the paper's units: Table 2 (three agents
+trained from scratch, mean +- std), the released agent in ViZDoom (where
+``--vizdoom`` has it), the released agent in mjmaze. The same agent, protocol and mazes in both engines make the last two
 a direct measure of how faithful each scenario is: the ``fidelity`` column
 says whether mjmaze's score lies within 10% of ViZDoom's on both splits
 (within 0.05 of a success or item-score fraction, 10% of the tics) and its
