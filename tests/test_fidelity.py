@@ -16,7 +16,7 @@ import mjmaze
 from mjmaze import layouts, walls
 from mjmaze.tasks import base, find_return, k_item, two_colour
 
-from conftest import FORWARD, TURN_LEFT, place
+from conftest import FORWARD, place
 
 STEP = -0.0004
 TOLERANCE = 0.01  # metres: the agent stops at its radius within this
