@@ -33,10 +33,14 @@ def frame_at(env, x, y, yaw):
     return env.task.get_observation(env.physics)["pixels"].astype(float)
 
 
-def wall_grey(env, distance):
-    """Mean of the frame's centre facing the +x outer wall from ``distance`` m."""
+def wall_colour(env, distance):
+    """Mean colour of the frame's centre facing the +x outer wall from ``distance`` m."""
     face = env.task.config.size * env.task.config.cell_size / 2 - walls.WALL_THICKNESS / 2
-    return frame_at(env, face - distance, 0.0, 0.0)[24:32, 50:62].mean()
+    return frame_at(env, face - distance, 0.0, 0.0)[24:32, 50:62].reshape(-1, 3).mean(axis=0)
+
+
+def wall_grey(env, distance):
+    return wall_colour(env, distance).mean()
 
 
 def test_walls_are_as_dim_as_vizdooms_and_brighter_near_the_eye():
@@ -55,8 +59,7 @@ def test_two_colour_walls_are_the_released_grey_stone2():
     env = mjmaze.load("two_colour", task_kwargs={"complexity": 0, "random": 0})
     env.reset()
     env.physics.show_objects(env.physics.object_ids([o.name for o in env.task.objects])[1], False)
-    face = env.task.config.size * env.task.config.cell_size / 2 - walls.WALL_THICKNESS / 2
-    red, green, blue = frame_at(env, face - 1.0, 0.0, 0.0)[24:32, 50:62].reshape(-1, 3).mean(axis=0)
+    red, green, blue = wall_colour(env, 1.0)
     env.task.close()
     assert (red, green, blue) == pytest.approx((38, 38, 38), abs=CLOSE)
     assert max(red, green, blue) - min(red, green, blue) < 4  # grey, not green-grey
