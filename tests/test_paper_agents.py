@@ -6,6 +6,7 @@ import os
 import pathlib
 import shutil
 
+import numpy as np
 import pytest
 import torch
 
@@ -164,3 +165,32 @@ def test_the_table_plays_again_an_evaluation_made_with_an_older_env_version(monk
     out.write_text(json.dumps(play("paper:two_colour_1")))
     paper_table.evaluate_all(["two_colour_1"])
     assert len(played) == 2  # the call above, not a third play
+    # Asked for more episodes per maze than it has: played again.
+    paper_table.evaluate_all(["two_colour_1"], plays_per_config=8)
+    assert len(played) == 3
+
+
+def test_the_tables_gap_interval_holds_a_true_gap_and_zero_only_for_noise():
+    from mjmaze.train import paper_table
+
+    rng = np.random.default_rng(0)
+    hardness = rng.uniform(200, 2000, size=64)  # mazes differ far more than the engines
+
+    def split(scale, noise):
+        return {"per_episode": [(m, float(hardness[m] * scale + noise * rng.normal()), 100)
+                                for m in range(64) for _ in range(2)]}
+
+    vizdoom = split(1.0, 50.0)
+    # 20% longer in every maze: the paired interval says so, far from 0.
+    gap, low, high = paper_table.gap(split(1.2, 50.0), vizdoom, "tics survived")
+    assert gap == pytest.approx(0.2, abs=0.03) and 0.1 < low < gap < high < 0.3
+    # The same engine twice: the interval holds 0.
+    gap, low, high = paper_table.gap(split(1.0, 50.0), vizdoom, "tics survived")
+    assert low < 0.0 < high and abs(gap) < 0.05
+    # Success in points: five more successes in 64 mazes.
+    ours = {"per_episode": [(m, 100.0 if m < 40 else 0.0, 50) for m in range(64)]}
+    theirs = {"per_episode": [(m, 100.0 if m < 35 else 0.0, 50) for m in range(64)]}
+    gap, low, high = paper_table.gap(ours, theirs, "success %")
+    assert gap == pytest.approx(100 * 5 / 64) and 0.0 <= low < gap < high
+    assert paper_table.format_gap((0.171, 0.052, 0.3), "tics survived") == "+17% (+5, +30)"
+    assert paper_table.gap({"value": 1.0}, theirs, "success %") is None  # made before episodes were kept

@@ -237,6 +237,27 @@ def test_a_random_policy_is_evaluated_the_same_way(tmp_path, monkeypatch):
         assert 0.0 <= result[split]["value"] <= 1.0  # items in order / K
         # The paper's K-item curves are in return / (K x 0.5): the mean return over 1.0.
         assert result[split]["curve_value"] == pytest.approx(result[split]["mean_return"])
+        # Every episode is kept (for paper_table's intervals), in the table's units.
+        per_episode = result[split]["per_episode"]
+        assert [config for config, _, _ in per_episode] == result[split]["configs"]
+        assert sum(value for _, value, _ in per_episode) / 8 == pytest.approx(result[split]["value"])
+
+
+@pytest.mark.slow
+def test_more_plays_per_maze_and_another_seed_give_more_and_other_episodes(tmp_path, monkeypatch):
+    monkeypatch.setattr(evaluate, "EVAL_CONFIGS", 4)
+    results = []
+    for seed in ("0", "7"):
+        out = tmp_path / f"random_{seed}.json"
+        evaluate.main(["random", "--scenario", "labyrinth", "--size", "5", "--num-envs", "2", "--plays", "3",
+                       "--seed", seed, "--out", str(out)])
+        results.append(json.loads(out.read_text())["test"])
+    for result, seed in zip(results, (0, 7)):
+        assert result["configs"] == sorted(list(range(4)) * 3)  # each exactly three times
+        assert result["plays_per_config"] == 3 and result["seed"] == seed
+    assert results[0]["per_episode"] != results[1]["per_episode"]  # other spawn headings, other random actions
+    with pytest.raises(SystemExit, match="at least once"):
+        evaluate.main(["random", "--num-envs", "2", "--plays", "0"])
 
 
 def start_training(tmp_path, name: str, *flags: str):

@@ -78,9 +78,14 @@ def _metric(scenario: str, rewards: list[float], steps: int, num_items: int | No
     return float(steps * FRAME_SKIP)  # two_colour: tics survived
 
 
-def play(job: tuple[str, str, str]) -> tuple[str, str, dict]:
-    """Plays one agent on one split's first 64 mazes, each twice; returns ``(name, split, result)``."""
-    name, split, checkout = job
+def play(job: tuple[str, str, str, int, int]) -> tuple[str, str, dict]:
+    """Plays one agent on one split's first 64 mazes, each ``plays`` times; returns ``(name, split, result)``.
+
+    Maze ``i``'s game is seeded with ``seed * 1000 + i`` (Doom's random draws:
+    the spawn heading, Two-colour's items), so ``seed`` gives other episodes
+    of the same mazes: what the score varies by from sampling alone.
+    """
+    name, split, checkout, seed, plays_per_maze = job
     torch.set_num_threads(1)
     info = paper_agents.get(name)
     _, agent, _ = paper_agents.load(name, paper_dir=checkout)
@@ -91,7 +96,7 @@ def play(job: tuple[str, str, str]) -> tuple[str, str, dict]:
     mazes = list(range(paper_agents.MAZES_PER_SPLIT))
     for first in range(0, len(mazes), BATCH):
         batch = mazes[first:first + BATCH]
-        games = [_game(folder / f"custom_scenario{index:03d}.cfg", seed=index) for index in batch]
+        games = [_game(folder / f"custom_scenario{index:03d}.cfg", seed=seed * 1000 + index) for index in batch]
         plays = [0] * len(games)
         rewards = [[] for _ in games]
         hidden = agent.initial_state(len(games))
@@ -113,9 +118,9 @@ def play(job: tuple[str, str, str]) -> tuple[str, str, dict]:
                     plays[i] += 1
                     rewards[i] = []
                     starts[i] = True
-                    if plays[i] < PLAYS_PER_MAZE:
+                    if plays[i] < plays_per_maze:
                         games[i].new_episode()
-            live = [i for i in live if plays[i] < PLAYS_PER_MAZE]
+            live = [i for i in live if plays[i] < plays_per_maze]
         for game in games:
             game.close()
     values = np.array([e["value"] for e in episodes])
@@ -124,6 +129,9 @@ def play(job: tuple[str, str, str]) -> tuple[str, str, dict]:
         "mean_return": float(np.mean([e["return"] for e in episodes])),
         "mean_length": float(np.mean([e["length"] for e in episodes])),
         "configs": sorted(e["config_index"] for e in episodes),
+        "seed": seed, "plays_per_config": plays_per_maze,
+        # Each episode's (configuration, metric in the table's units, agent steps): for paper_table's intervals.
+        "per_episode": sorted((e["config_index"], e["value"], e["length"]) for e in episodes),
     }
 
 
@@ -247,6 +255,8 @@ def main() -> None:
     parser.add_argument("--only", nargs="+", default=None, metavar="SETTING", help="e.g. labyrinth_9 two_colour_1")
     parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("runs/paper/vizdoom.json"))
     parser.add_argument("--processes", type=int, default=None, help="default: one per core")
+    parser.add_argument("--plays", type=int, default=PLAYS_PER_MAZE, help="episodes per maze (default 2)")
+    parser.add_argument("--seed", type=int, default=0, help="maze i's game is seeded with seed * 1000 + i")
     parser.add_argument("--agreement", metavar="SETTING", default=None,
                         help="instead: how often a Labyrinth or Two-colour agent acts alike on both engines' frames "
                              "at the same poses")
@@ -267,7 +277,9 @@ def main() -> None:
         raise SystemExit(f"error: {args.checkout} has no {paper_agents.MAZES}: pass a checkout of "
                          f"{paper_agents.RELEASED_REPOSITORY}")
     results = json.loads(args.out.read_text()) if args.out.exists() else {}  # kept: rerun only what is asked
-    jobs = [(name, split, str(args.checkout)) for name in names for split in ("train", "test")]
+    if args.plays < 1:
+        raise SystemExit(f"error: --plays must be at least 1, got {args.plays}")
+    jobs = [(name, split, str(args.checkout), args.seed, args.plays) for name in names for split in ("train", "test")]
     with mp.get_context("spawn").Pool(args.processes) as pool:
         for name, split, result in pool.imap_unordered(play, jobs):
             info = paper_agents.get(name)

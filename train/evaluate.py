@@ -45,18 +45,23 @@ def check_sizes(num_envs: int, num_configs: int | None = None) -> int:
 
 
 def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, device: torch.device, seed: int = 0,
-               num_configs: int | None = None, progress: bool = True, layouts: str | None = None) -> dict:
-    """Plays each of the first ``num_configs`` (default ``EVAL_CONFIGS``) configurations of ``split`` twice.
+               num_configs: int | None = None, progress: bool = True, layouts: str | None = None,
+               plays_per_config: int = PLAYS_PER_CONFIG) -> dict:
+    """Plays each of the first ``num_configs`` (default ``EVAL_CONFIGS``) configurations of ``split``
+    ``plays_per_config`` times (default twice).
 
     Actions are the argmax of ``agent``'s policy, or uniformly random ones
-    (seeded with ``seed``) for ``agent=None``. ``layouts``: a folder of
+    for ``agent=None``. ``seed`` seeds the envs (the episodes' random draws:
+    spawn headings, items) and the random actions. ``layouts``: a folder of
     released mazes to play instead of the split's generated ones.
     """
     num_configs = check_sizes(num_envs, num_configs)
+    if plays_per_config < 1:
+        raise ValueError(f"each configuration must be played at least once, got {plays_per_config} plays")
     # Env i starts at configuration i * 64 / num_envs and cycles, so its first
-    # 2 * 64 / num_envs episodes cover its block and the next: every
-    # configuration exactly twice.
-    per_env = PLAYS_PER_CONFIG * num_configs // num_envs
+    # k * 64 / num_envs episodes cover its block and the k - 1 after it: every
+    # configuration exactly k times.
+    per_env = plays_per_config * num_configs // num_envs
     task_kwargs = {k: v for k, v in args.task_kwargs().items() if k != "num_configs"}
     if layouts is not None:
         task_kwargs["layouts"] = layouts
@@ -108,11 +113,15 @@ def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, devic
         # In the units of the paper's training curves (the metric but for K-item's normalised return).
         "curve_value": float(np.mean([e[declared.curve_field] for e in played])) * declared.curve_scale,
         "configs": sorted(e["config_index"] for e in played),
+        "seed": seed, "plays_per_config": plays_per_config,
+        # Each episode's (configuration, metric in the table's units, agent steps): paper_table's intervals.
+        "per_episode": sorted((e["config_index"], float(e[metric]) * scale, e["length"]) for e in played),
     }
 
 
 def evaluate_random(args: Args, num_envs: int = 16, out: str | pathlib.Path | None = None,
-                    num_configs: int | None = None, seed: int = 0, progress: bool = True) -> dict:
+                    num_configs: int | None = None, seed: int = 0, progress: bool = True,
+                    plays_per_config: int = PLAYS_PER_CONFIG) -> dict:
     """A uniformly random policy, evaluated as :func:`evaluate` evaluates a run; written to ``out`` if given."""
     check_sizes(num_envs, num_configs)
     result = {
@@ -122,7 +131,7 @@ def evaluate_random(args: Args, num_envs: int = 16, out: str | pathlib.Path | No
     }
     for split in ("train", "test"):
         result[split] = play_split(None, args, split, num_envs, torch.device("cpu"), seed=seed, num_configs=num_configs,
-                                   progress=progress)
+                                   progress=progress, plays_per_config=plays_per_config)
     if out:
         files.atomic_write_json(pathlib.Path(out), result)
     return result
@@ -130,20 +139,26 @@ def evaluate_random(args: Args, num_envs: int = 16, out: str | pathlib.Path | No
 
 def evaluate(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | None = None, num_envs: int = 16,
              device: str = "auto", out: str | pathlib.Path | None = None, num_configs: int | None = None,
-             torch_threads: int | None = INFERENCE_THREADS, progress: bool = True) -> dict:
+             torch_threads: int | None = INFERENCE_THREADS, progress: bool = True,
+             plays_per_config: int = PLAYS_PER_CONFIG, seed: int = 0) -> dict:
     """Evaluates a run's checkpoint (default: its latest) on train and test.
 
     ``num_configs`` configurations per split (default ``EVAL_CONFIGS`` = 64),
-    each played twice. Writes the result to ``out`` (default: the run's ``eval.json``).
+    each played ``plays_per_config`` times, the envs seeded with ``seed``.
+    Writes the result to ``out`` (default: the run's ``eval.json``).
     ``torch_threads``: PyTorch's CPU threads meanwhile (None: as they are).
     """
     check_sizes(num_envs, num_configs)
+    if plays_per_config < 1:
+        raise ValueError(f"each configuration must be played at least once, got {plays_per_config} plays")
     torch_device = pick_device(device)
     with using_torch_threads(torch_threads):
-        return _evaluate(run_dir, checkpoint_path, num_envs, torch_device, out, num_configs, progress)
+        return _evaluate(run_dir, checkpoint_path, num_envs, torch_device, out, num_configs, progress,
+                         plays_per_config, seed)
 
 
-def _evaluate(run_dir, checkpoint_path, num_envs, torch_device, out, num_configs, progress) -> dict:
+def _evaluate(run_dir, checkpoint_path, num_envs, torch_device, out, num_configs, progress, plays_per_config,
+              seed) -> dict:
     args, agent, state = policy.load_run(run_dir, checkpoint_path, torch_device)
     result = {
         "run": str(run_dir),
@@ -160,8 +175,8 @@ def _evaluate(run_dir, checkpoint_path, num_envs, torch_device, out, num_configs
     if layouts:
         result["released_mazes"] = layouts
     for split in ("train", "test"):
-        result[split] = play_split(agent, args, split, num_envs, torch_device, num_configs=num_configs,
-                                   progress=progress, layouts=layouts.get(split))
+        result[split] = play_split(agent, args, split, num_envs, torch_device, seed=seed, num_configs=num_configs,
+                                   progress=progress, layouts=layouts.get(split), plays_per_config=plays_per_config)
     files.atomic_write_json(pathlib.Path(out) if out else default_output(run_dir), result)
     return result
 
@@ -195,15 +210,19 @@ def main(argv: list[str] | None = None) -> None:
                         help="PyTorch CPU threads (default 1: the network reads one small batch per step)")
     parser.add_argument("--out", type=pathlib.Path, default=None,
                         help="where to write the result (default: the run's eval.json; for random, nowhere)")
+    parser.add_argument("--plays", type=int, default=PLAYS_PER_CONFIG,
+                        help=f"episodes per configuration (default {PLAYS_PER_CONFIG})")
+    parser.add_argument("--seed", type=int, default=0, help="seeds the envs' random draws (spawn heading, items)")
     suite.difficulty_arguments(parser)  # for random: the scenario and its difficulty
     args = parser.parse_args(argv)
     try:
         if str(args.run_dir) == "random":
             settings = Args(scenario=args.scenario or suite.DEFAULT_SCENARIO, **suite.difficulty_kwargs(args))
-            result = evaluate_random(settings, args.num_envs, args.out)
+            result = evaluate_random(settings, args.num_envs, args.out, seed=args.seed,
+                                     plays_per_config=args.plays)
         else:
             result = evaluate(args.run_dir, args.checkpoint, args.num_envs, args.device, out=args.out,
-                              torch_threads=args.torch_threads)
+                              torch_threads=args.torch_threads, plays_per_config=args.plays, seed=args.seed)
     except (checkpoint.CheckpointError, FileNotFoundError, ValueError) as error:
         raise SystemExit(f"error: {error}") from None
     print(format_table(result))

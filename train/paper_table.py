@@ -3,6 +3,7 @@
     python -m mjmaze.train.paper_table                                    # all 16 settings (~15 min on 2 cores)
     python -m mjmaze.train.paper_table --only labyrinth_9 two_colour_1
     python -m mjmaze.train.paper_table --vizdoom runs/paper/vizdoom.json  # + tools/paper_agents_vizdoom.py's column
+    python -m mjmaze.train.paper_table --plays 8 --seed 1 --redo          # more episodes: tighter intervals
 
 Each released agent (``mjmaze.train.paper_agents``) plays its setting's released
 mazes in mjmaze, greedily, as ``mjmaze.train.evaluate`` plays a run (the first
@@ -15,15 +16,24 @@ trained from scratch, mean +- std), the released agent in ViZDoom (where
 a direct measure of how faithful each scenario is: the ``fidelity`` column
 says whether mjmaze's score lies within 10% of ViZDoom's on both splits
 (within 0.05 of a success or item-score fraction, 10% of the tics) and its
-mean episode length within 20%. Writes ``<out>.md`` and ``<out>.json``.
+mean episode length within 20%. Where both engines kept each episode, the
+``gap`` column gives mjmaze's score less ViZDoom's (for tics, relative to
+ViZDoom's) with its 95% interval, from resampling the mazes (both engines
+play the same ones, so a maze's draw moves both sides): a gap whose interval
+holds 0 is not told apart from sampling noise by that many episodes, one
+whose interval lies beyond the tolerance is a difference between the
+engines. Writes ``<out>.md`` and ``<out>.json``.
 """
 
 from __future__ import annotations
 
 import argparse
+import collections
 import json
 import os
 import pathlib
+
+import numpy as np
 
 from mjmaze import files, registry
 
@@ -32,22 +42,27 @@ from .settings import INFERENCE_THREADS
 
 SCORE_TOLERANCE = 0.10  # of ViZDoom's score (or of the whole range for success %, item score)
 LENGTH_TOLERANCE = 0.20
+RESAMPLES = 4000  # bootstrap draws of the mazes for a gap's interval
 
 
 def evaluate_all(names: list[str], num_envs: int = 16, redo: bool = False,
-                 torch_threads: int | None = INFERENCE_THREADS) -> dict[str, dict]:
+                 torch_threads: int | None = INFERENCE_THREADS, plays_per_config: int = evaluate.PLAYS_PER_CONFIG,
+                 seed: int = 0) -> dict[str, dict]:
     """Each named agent's evaluation in mjmaze (played now, or read from an earlier call)."""
     results = {}
     for name in names:
         out = evaluate.default_output(paper_agents.PREFIX + name)
         current = registry.get(paper_agents.get(name).scenario).gym_id
-        # Reused only if made with today's env version: a result must be of the scenario as it is.
+        # Reused only if made with today's env version (a result must be of the scenario as it is)
+        # and as many plays from the same seed.
         earlier = json.loads(out.read_text()) if out.exists() and not redo else None
-        if earlier is not None and earlier.get("env_id") == current:
+        if earlier is not None and earlier.get("env_id") == current and all(
+                earlier[split].get("plays_per_config", evaluate.PLAYS_PER_CONFIG) == plays_per_config
+                and earlier[split].get("seed", 0) == seed for split in ("train", "test")):
             results[name] = earlier
             continue
         results[name] = evaluate.evaluate(paper_agents.PREFIX + name, num_envs=num_envs, out=out,
-                                          torch_threads=torch_threads)
+                                          torch_threads=torch_threads, plays_per_config=plays_per_config, seed=seed)
         r = results[name]
         print(f"{name}: train {r['train']['value']:.3g}, test {r['test']['value']:.3g} {r['units']}", flush=True)
     return results
@@ -60,6 +75,38 @@ def within(mjmaze_value: float, vizdoom_value: float, units: str) -> bool:
     if units.startswith("items"):
         return abs(mjmaze_value - vizdoom_value) <= SCORE_TOLERANCE
     return abs(mjmaze_value - vizdoom_value) <= SCORE_TOLERANCE * abs(vizdoom_value)
+
+
+def gap(mjmaze_split: dict, vizdoom_split: dict, units: str, resamples: int = RESAMPLES,
+        seed: int = 0) -> tuple[float, float, float] | None:
+    """mjmaze's score less ViZDoom's and its 95% interval, ``(gap, low, high)``; None without both engines' episodes.
+
+    Success % and item scores differ in their own units, tics relative to
+    ViZDoom's mean (0.1 = 10% longer). The interval is a paired bootstrap
+    over the mazes both engines played: each draw takes the mazes with
+    replacement and compares the two engines' means over those mazes.
+    """
+    if "per_episode" not in mjmaze_split or "per_episode" not in vizdoom_split:
+        return None
+    per_maze = []
+    for split in (mjmaze_split, vizdoom_split):
+        values = collections.defaultdict(list)
+        for config, value, _ in split["per_episode"]:
+            values[int(config)].append(value)
+        per_maze.append(values)
+    mazes = sorted(set(per_maze[0]) & set(per_maze[1]))
+    if not mazes:
+        return None
+    ours = np.array([np.mean(per_maze[0][m]) for m in mazes])
+    theirs = np.array([np.mean(per_maze[1][m]) for m in mazes])
+    draws = np.random.default_rng(seed).integers(len(mazes), size=(resamples, len(mazes)))
+
+    def difference(a, b):
+        return a / b - 1.0 if units == "tics survived" else a - b
+
+    point = float(difference(ours.mean(), theirs.mean()))
+    low, high = np.percentile(difference(ours[draws].mean(axis=1), theirs[draws].mean(axis=1)), [2.5, 97.5])
+    return point, float(low), float(high)
 
 
 def rows(mjmaze_results: dict[str, dict], vizdoom_results: dict[str, dict]) -> list[dict]:
@@ -77,7 +124,7 @@ def rows(mjmaze_results: dict[str, dict], vizdoom_results: dict[str, dict]) -> l
                                                  "test": paper[2], "test_std": paper[3]},
             "mjmaze": {split: result[split]["value"] for split in ("train", "test")},
             "mjmaze_length": {split: result[split].get("mean_length") for split in ("train", "test")},
-            "vizdoom": None, "vizdoom_length": None, "fidelity": None,
+            "vizdoom": None, "vizdoom_length": None, "fidelity": None, "gap": None,
         }
         if doom is not None:
             row["vizdoom"] = {split: doom[split]["value"] for split in ("train", "test")}
@@ -87,8 +134,19 @@ def rows(mjmaze_results: dict[str, dict], vizdoom_results: dict[str, dict]) -> l
                           and abs(row["mjmaze_length"][s] - row["vizdoom_length"][s])
                           <= LENGTH_TOLERANCE * row["vizdoom_length"][s] for s in ("train", "test"))
             row["fidelity"] = {"scores": scores, "lengths": lengths}
+            row["gap"] = {split: gap(result[split], doom[split], row["units"]) for split in ("train", "test")}
         table.append(row)
     return table
+
+
+def format_gap(interval: tuple[float, float, float] | None, units: str) -> str:
+    """``+17% (+5, +30)`` for tics, ``-6.2 (-12.5, 0.0)`` for success %, ``+0.02 (-0.01, +0.05)`` for item scores."""
+    if interval is None:
+        return "–"
+    if units == "tics survived":
+        return "{:+.0f}% ({:+.0f}, {:+.0f})".format(*(100 * v for v in interval))
+    digits = 1 if units == "success %" else 2
+    return "{:+.{d}f} ({:+.{d}f}, {:+.{d}f})".format(*interval, d=digits)
 
 
 def markdown(table: list[dict]) -> str:
@@ -97,8 +155,9 @@ def markdown(table: list[dict]) -> str:
 
     lines = [
         "| setting | units | train: paper | ViZDoom | mjmaze | test: paper | ViZDoom | mjmaze | "
-        "steps per episode, ViZDoom / mjmaze | within 10% (score), 20% (length) |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        "steps per episode, ViZDoom / mjmaze | within 10% (score), 20% (length) | "
+        "gap, train / test (95% interval) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for row in table:
         digits = registry.get(row["scenario"]).metric_digits
@@ -115,6 +174,8 @@ def markdown(table: list[dict]) -> str:
         fidelity = row["fidelity"]
         cells.append("–" if fidelity is None else
                      f"{'yes' if fidelity['scores'] else 'no'}, {'yes' if fidelity['lengths'] else 'no'}")
+        gaps = row.get("gap") or {}
+        cells.append(" / ".join(format_gap(gaps.get(s), row["units"]) for s in ("train", "test")))
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 
@@ -129,6 +190,9 @@ def main(argv: list[str] | None = None) -> None:
                         help="writes <out>.md and <out>.json")
     parser.add_argument("--num-envs", type=int, default=16, help="parallel envs (must divide 64)")
     parser.add_argument("--redo", action="store_true", help="play again the settings already evaluated")
+    parser.add_argument("--plays", type=int, default=evaluate.PLAYS_PER_CONFIG,
+                        help=f"episodes per maze (default {evaluate.PLAYS_PER_CONFIG}; more: tighter gap intervals)")
+    parser.add_argument("--seed", type=int, default=0, help="seeds the episodes' random draws")
     parser.add_argument("--paper-dir", default=None,
                         help="a local copy of the released files (default: MJMAZE_PAPER_DIR, else download)")
     parser.add_argument("--torch-threads", type=int, default=INFERENCE_THREADS)
@@ -139,7 +203,9 @@ def main(argv: list[str] | None = None) -> None:
         names = [paper_agents.get(name).name for name in (args.only or paper_agents.AGENTS)]
         evaluate.check_sizes(args.num_envs)
         vizdoom_results = json.loads(args.vizdoom.read_text()) if args.vizdoom else {}
-        results = evaluate_all(names, args.num_envs, args.redo, args.torch_threads)
+        if args.plays < 1:
+            raise ValueError(f"--plays must be at least 1, got {args.plays}")
+        results = evaluate_all(names, args.num_envs, args.redo, args.torch_threads, args.plays, args.seed)
     except (FileNotFoundError, ValueError, json.JSONDecodeError) as error:
         raise SystemExit(f"error: {error}") from None
     table = rows(results, vizdoom_results)
