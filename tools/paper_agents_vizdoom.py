@@ -3,6 +3,7 @@
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT [--only labyrinth_9 two_colour_1] [--out FILE]
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --agreement labyrinth_7   # the same action at the same pose?
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --agreement two_colour_1  # ... with ViZDoom's items placed
+    python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --picks two_colour_5      # right and wrong picks, both engines
 
 RELEASED_CHECKOUT is a checkout of github.com/edbeeching/3d_control_deep_rl
 (its ``3dcdrl/scenarios/custom_scenarios/`` holds each maze's ``.cfg``/``.wad``,
@@ -135,8 +136,11 @@ def play(job: tuple[str, str, str, int, int]) -> tuple[str, str, dict]:
     }
 
 
-def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False) -> float:
+def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False) -> tuple[float, float]:
     """How often the agent chooses, on mjmaze's frame, the action it chose on ViZDoom's frame at the same pose.
+
+    Returns that share and, for scale, the share on ViZDoom's own frames moved
+    one pixel sideways (the agent's choices are that sensitive to any change).
 
     The agent plays the first ``mazes`` test mazes greedily in ViZDoom; each of
     its poses is then set in mjmaze (head-bob off: its phase is ViZDoom's own)
@@ -162,7 +166,7 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
     folder = pathlib.Path(checkout) / paper_agents.MAZES / info.maze_folder / "test"
     env = mjmaze.load(info.scenario, task_kwargs={**info.task_kwargs, "layouts": str(folder), "head_bob": False})
     task = env.task
-    same = []
+    same, same_shifted = [], []
     for index in range(mazes):
         maze = json.loads((folder / f"custom_scenario{index:03d}.json").read_text())
         centre = np.mean(np.array(maze["exterior"], dtype=float), axis=0)  # mjmaze centres the maze on (0, 0)
@@ -177,7 +181,8 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
                 logits, _, hidden = agent.step(agent.features(torch.from_numpy(_frame(game)[None])), hidden, start)
             start[:] = False
             action = int(logits.argmax())
-            path.append((*_metres(x, y, centre), math.radians(angle), action, things, tuple(flashes)))
+            path.append((*_metres(x, y, centre), math.radians(angle), action, things, tuple(flashes),
+                         np.roll(_frame(game), 1, axis=1)))
             for _ in range(FRAME_SKIP):  # tic by tic, to follow the flash counters
                 game.make_action(LIMITED_ACTIONS[action], 1)
                 flashes = [max(count - 1, 0) for count in flashes]
@@ -194,7 +199,8 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
         while task.config.index != index:
             env.reset()
         hidden, start = agent.initial_state(1), torch.ones(1, dtype=torch.bool)
-        for x, y, yaw, action, things, flashes in path:
+        shifted_hidden = agent.initial_state(1)
+        for x, y, yaw, action, things, flashes, shifted in path:
             if two_colour:
                 _place_two_colour_things(task, env.physics, things, flashes, hide_items)
             env.physics.set_agent_pose(x, y, yaw)
@@ -202,10 +208,85 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
             frame = np.ascontiguousarray(task.get_observation(env.physics)["pixels"])
             with torch.no_grad():
                 logits, _, hidden = agent.step(agent.features(torch.from_numpy(frame[None])), hidden, start)
+                shifted_logits, _, shifted_hidden = agent.step(agent.features(torch.from_numpy(shifted[None])),
+                                                               shifted_hidden, start)
             start[:] = False
             same.append(int(logits.argmax()) == action)
+            same_shifted.append(int(shifted_logits.argmax()) == action)
     task.close()
-    return float(np.mean(same))
+    return float(np.mean(same)), float(np.mean(same_shifted))
+
+
+def picks(name: str, checkout: str, mazes: int = 32) -> dict[str, dict]:
+    """A Two-colour agent's picks in both engines: right and wrong items per 100 tics, by the totem's colour.
+
+    The agent plays the first ``mazes`` test mazes twice, greedily, in each
+    engine (Doom's draws seeded as ``play``'s ``seed=1``). ViZDoom's counts
+    are the released script's ``shaping_reward`` (+1 a right item, -1 a wrong
+    one), mjmaze's its items leaving the floor. Returns, per engine, a row
+    per totem colour (``green``, ``red``, ``none``: a released spawn on the
+    totem's spot) and ``all``: episodes, mean tics, right and wrong per 100 tics.
+    """
+    import vizdoom as vzd
+
+    import mjmaze
+    from mjmaze.train import policy
+
+    info = paper_agents.get(name)
+    if info.scenario != "two_colour":
+        raise ValueError(f"--picks takes a Two-colour agent (two_colour_1 .. two_colour_7), got {name}")
+    _, agent, _ = paper_agents.load(name, paper_dir=checkout)
+    folder = pathlib.Path(checkout) / paper_agents.MAZES / info.maze_folder / "test"
+    episodes = {"vizdoom": [], "mjmaze": []}
+    for index in range(mazes):
+        maze = json.loads((folder / f"custom_scenario{index:03d}.json").read_text())
+        centre = np.mean(np.array(maze["exterior"], dtype=float), axis=0)
+        game = _game(folder / f"custom_scenario{index:03d}.cfg", seed=1000 + index, objects=True)
+        game.add_available_game_variable(vzd.GameVariable.USER1)  # the script's global 1, shaping_reward (fixed point)
+        for play_index in range(PLAYS_PER_MAZE):
+            if play_index:
+                game.new_episode()
+            player, totem_green = policy.Policy(agent), _two_colour_things(game, centre)[1]
+            steps, right, wrong = 0, 0, 0
+            shaping = game.get_game_variable(vzd.GameVariable.USER1)
+            while not game.is_episode_finished():
+                game.make_action(LIMITED_ACTIONS[player.act(_frame(game))], FRAME_SKIP)
+                steps += 1
+                if game.is_episode_finished():
+                    break
+                change = round((game.get_game_variable(vzd.GameVariable.USER1) - shaping) / 65536)
+                shaping += change * 65536
+                right, wrong = right + max(change, 0), wrong + max(-change, 0)
+            episodes["vizdoom"].append((totem_green, steps * FRAME_SKIP, right, wrong))
+        game.close()
+    env = mjmaze.load("two_colour", task_kwargs={**info.task_kwargs, "layouts": str(folder), "num_configs": mazes,
+                                                  "config_sampling": "cycle", "random": 1})
+    task = env.task
+    for _ in range(PLAYS_PER_MAZE * mazes):
+        timestep, player = env.reset(), policy.Policy(agent)
+        totem_green = bool(task.totem_green) if task.state["object_shown"][task.row, 0] else None
+        steps, right, wrong, on_floor = 0, 0, 0, task.item_active.copy()
+        while not timestep.last():
+            timestep = env.step(player.act(timestep.observation["pixels"]))
+            steps += 1
+            taken = on_floor & ~task.item_active
+            right += int((taken & (task.item_green == task.totem_green)).sum())
+            wrong += int((taken & (task.item_green != task.totem_green)).sum())
+            on_floor = task.item_active.copy()
+        episodes["mjmaze"].append((totem_green, steps * FRAME_SKIP, right, wrong))
+    task.close()
+    table = {}
+    for engine, played in episodes.items():
+        rows = {}
+        for label, totem in (("all", ...), ("green", True), ("red", False), ("none", None)):
+            chosen = [e for e in played if totem is ... or e[0] is totem]
+            tics = sum(e[1] for e in chosen)
+            if chosen:
+                rows[label] = {"episodes": len(chosen), "tics": tics / len(chosen),
+                               "right": 100 * sum(e[2] for e in chosen) / tics,
+                               "wrong": 100 * sum(e[3] for e in chosen) / tics}
+        table[engine] = rows
+    return table
 
 
 def _metres(x: float, y: float, centre: np.ndarray) -> tuple[float, float]:
@@ -257,6 +338,8 @@ def main() -> None:
     parser.add_argument("--processes", type=int, default=None, help="default: one per core")
     parser.add_argument("--plays", type=int, default=PLAYS_PER_MAZE, help="episodes per maze (default 2)")
     parser.add_argument("--seed", type=int, default=0, help="maze i's game is seeded with seed * 1000 + i")
+    parser.add_argument("--picks", metavar="SETTING", default=None,
+                        help="instead: a Two-colour agent's right and wrong picks in both engines, by totem colour")
     parser.add_argument("--agreement", metavar="SETTING", default=None,
                         help="instead: how often a Labyrinth or Two-colour agent acts alike on both engines' frames "
                              "at the same poses")
@@ -265,10 +348,24 @@ def main() -> None:
         scenario = paper_agents.get(args.agreement).scenario
         if scenario not in ("labyrinth", "two_colour"):
             raise SystemExit("error: --agreement takes a Labyrinth or Two-colour agent (labyrinth_7 .. two_colour_7)")
-        print(f"{args.agreement}: the same action at {agreement(args.agreement, str(args.checkout)):.1%} of the "
-              "poses of its ViZDoom episodes (first 8 test mazes)")
+        share, shifted = agreement(args.agreement, str(args.checkout))
+        print(f"{args.agreement}: the same action at {share:.1%} of the poses of its ViZDoom episodes (first 8 test "
+              f"mazes); on ViZDoom's own frames moved 1 pixel sideways: {shifted:.1%}")
         if scenario == "two_colour":
-            print(f"  with mjmaze's items hidden: {agreement(args.agreement, str(args.checkout), hide_items=True):.1%}")
+            hidden = agreement(args.agreement, str(args.checkout), hide_items=True)[0]
+            print(f"  with mjmaze's items hidden: {hidden:.1%}")
+        return
+    if args.picks:
+        try:
+            table = picks(args.picks, str(args.checkout))
+        except ValueError as error:
+            raise SystemExit(f"error: {error}") from None
+        print(f"{args.picks}, first 32 test mazes twice: | engine | totem | episodes | tics | right | wrong "
+              "(per 100 tics) |")
+        for engine, rows in table.items():
+            for label, row in rows.items():
+                print(f"| {engine} | {label} | {row['episodes']} | {row['tics']:.0f} | {row['right']:.2f} | "
+                      f"{row['wrong']:.2f} |")
         return
     names = args.only or list(paper_agents.AGENTS)
     for name in names:

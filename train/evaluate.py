@@ -2,13 +2,16 @@
 
     python -m mjmaze.train.evaluate runs/labyrinth_5_s0 [--checkpoint PATH] [--num-envs 16]
     python -m mjmaze.train.evaluate random --scenario labyrinth --size 7   # a uniformly random policy, the same way
+    python -m mjmaze.train.evaluate paper:two_colour_5 --plays 8 --seed 1  # more episodes, other draws
 
 **Decision** (also in the README): each of the first 64 test configurations, and
 64 training ones, is played twice to its end or the time limit - 128 episodes
 per split - rather than the released "first 128 episodes to finish", which
-favoured short episodes. Actions are the argmax of the policy. Writes
-``eval.json`` into the run folder (atomically) with each split's metric in the
-units of the paper's Table 2, and prints the table.
+favoured short episodes (``--plays`` more times each where the draws' noise
+matters: Two-colour's items, the spawn headings). Actions are the argmax of
+the policy. Writes ``eval.json`` into the run folder (atomically) with each
+split's metric in the units of the paper's Table 2 and every episode's value,
+and prints the table.
 """
 
 from __future__ import annotations
