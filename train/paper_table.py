@@ -15,7 +15,7 @@ trained from scratch, mean +- std), the released agent in ViZDoom (where
 ``--vizdoom`` has it), the released agent in mjmaze. The same agent, protocol and mazes in both engines make the last two
 a direct measure of how faithful each scenario is: the ``fidelity`` column
 says whether mjmaze's score lies within 10% of ViZDoom's on both splits
-(within 0.05 of a success or item-score fraction, 10% of the tics) and its
+(10 points of success, 0.1 of an item score, 10% of the tics) and its
 mean episode length within 20%. Where both engines kept each episode, the
 ``gap`` column gives mjmaze's score less ViZDoom's (for tics, relative to
 ViZDoom's) with its 95% interval, from resampling the mazes (both engines
