@@ -60,6 +60,11 @@ def _game(cfg: pathlib.Path, seed: int = 0, objects: bool = False):
     return game
 
 
+def _maze_seed(seed: int, index: int) -> int:
+    """Doom's seed for maze ``index`` of a run seeded ``seed``: other seeds, other episodes of the same mazes."""
+    return seed * 1000 + index
+
+
 def _frame(game) -> np.ndarray:
     import cv2
 
@@ -97,7 +102,7 @@ def play(job: tuple[str, str, str, int, int]) -> tuple[str, str, dict]:
     mazes = list(range(paper_agents.MAZES_PER_SPLIT))
     for first in range(0, len(mazes), BATCH):
         batch = mazes[first:first + BATCH]
-        games = [_game(folder / f"custom_scenario{index:03d}.cfg", seed=seed * 1000 + index) for index in batch]
+        games = [_game(folder / f"custom_scenario{index:03d}.cfg", seed=_maze_seed(seed, index)) for index in batch]
         plays = [0] * len(games)
         rewards = [[] for _ in games]
         hidden = agent.initial_state(len(games))
@@ -241,7 +246,7 @@ def picks(name: str, checkout: str, mazes: int = 32) -> dict[str, dict]:
     for index in range(mazes):
         maze = json.loads((folder / f"custom_scenario{index:03d}.json").read_text())
         centre = np.mean(np.array(maze["exterior"], dtype=float), axis=0)
-        game = _game(folder / f"custom_scenario{index:03d}.cfg", seed=1000 + index, objects=True)
+        game = _game(folder / f"custom_scenario{index:03d}.cfg", seed=_maze_seed(1, index), objects=True)
         game.add_available_game_variable(vzd.GameVariable.USER1)  # the script's global 1, shaping_reward (fixed point)
         for play_index in range(PLAYS_PER_MAZE):
             if play_index:

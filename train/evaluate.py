@@ -34,9 +34,12 @@ EVAL_CONFIGS = 64
 PLAYS_PER_CONFIG = 2
 
 
-def check_sizes(num_envs: int, num_configs: int | None = None) -> int:
-    """The number of configurations per split (default ``EVAL_CONFIGS``); ValueError if ``num_envs`` cannot play them."""
+def check_sizes(num_envs: int, num_configs: int | None = None, plays_per_config: int = PLAYS_PER_CONFIG) -> int:
+    """The number of configurations per split (default ``EVAL_CONFIGS``); ValueError if ``num_envs`` cannot play
+    them, or ``plays_per_config`` is below one."""
     num_configs = EVAL_CONFIGS if num_configs is None else num_configs
+    if plays_per_config < 1:
+        raise ValueError(f"each configuration must be played at least once, got {plays_per_config} plays")
     if num_configs < 1 or num_envs < 1:
         raise ValueError(f"evaluation needs at least 1 env and 1 configuration, got {num_envs} envs, {num_configs} "
                          "configurations")
@@ -58,9 +61,7 @@ def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, devic
     spawn headings, items) and the random actions. ``layouts``: a folder of
     released mazes to play instead of the split's generated ones.
     """
-    num_configs = check_sizes(num_envs, num_configs)
-    if plays_per_config < 1:
-        raise ValueError(f"each configuration must be played at least once, got {plays_per_config} plays")
+    num_configs = check_sizes(num_envs, num_configs, plays_per_config)
     # Env i starts at configuration i * 64 / num_envs and cycles, so its first
     # k * 64 / num_envs episodes cover its block and the k - 1 after it: every
     # configuration exactly k times.
@@ -126,7 +127,7 @@ def evaluate_random(args: Args, num_envs: int = 16, out: str | pathlib.Path | No
                     num_configs: int | None = None, seed: int = 0, progress: bool = True,
                     plays_per_config: int = PLAYS_PER_CONFIG) -> dict:
     """A uniformly random policy, evaluated as :func:`evaluate` evaluates a run; written to ``out`` if given."""
-    check_sizes(num_envs, num_configs)
+    check_sizes(num_envs, num_configs, plays_per_config)
     result = {
         "run": "random", "checkpoint": None, "step": 0, "scenario": args.scenario,
         "env_id": registry.get(args.scenario).gym_id,
@@ -151,9 +152,7 @@ def evaluate(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | 
     Writes the result to ``out`` (default: the run's ``eval.json``).
     ``torch_threads``: PyTorch's CPU threads meanwhile (None: as they are).
     """
-    check_sizes(num_envs, num_configs)
-    if plays_per_config < 1:
-        raise ValueError(f"each configuration must be played at least once, got {plays_per_config} plays")
+    check_sizes(num_envs, num_configs, plays_per_config)
     torch_device = pick_device(device)
     with using_torch_threads(torch_threads):
         return _evaluate(run_dir, checkpoint_path, num_envs, torch_device, out, num_configs, progress,

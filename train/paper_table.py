@@ -201,10 +201,8 @@ def main(argv: list[str] | None = None) -> None:
         os.environ["MJMAZE_PAPER_DIR"] = args.paper_dir
     try:
         names = [paper_agents.get(name).name for name in (args.only or paper_agents.AGENTS)]
-        evaluate.check_sizes(args.num_envs)
+        evaluate.check_sizes(args.num_envs, plays_per_config=args.plays)
         vizdoom_results = json.loads(args.vizdoom.read_text()) if args.vizdoom else {}
-        if args.plays < 1:
-            raise ValueError(f"--plays must be at least 1, got {args.plays}")
         results = evaluate_all(names, args.num_envs, args.redo, args.torch_threads, args.plays, args.seed)
     except (FileNotFoundError, ValueError, json.JSONDecodeError) as error:
         raise SystemExit(f"error: {error}") from None
