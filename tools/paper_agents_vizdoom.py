@@ -4,6 +4,7 @@
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --agreement labyrinth_7   # the same action at the same pose?
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --agreement two_colour_1  # ... with ViZDoom's items placed
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --picks two_colour_5      # right and wrong picks, both engines
+    python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --shift 1 --out F         # frames moved 1 px: the probe's scale
 
 RELEASED_CHECKOUT is a checkout of github.com/edbeeching/3d_control_deep_rl
 (its ``3dcdrl/scenarios/custom_scenarios/`` holds each maze's ``.cfg``/``.wad``,
@@ -84,14 +85,17 @@ def _metric(scenario: str, rewards: list[float], steps: int, num_items: int | No
     return float(steps * FRAME_SKIP)  # two_colour: tics survived
 
 
-def play(job: tuple[str, str, str, int, int]) -> tuple[str, str, dict]:
+def play(job: tuple[str, str, str, int, int, int]) -> tuple[str, str, dict]:
     """Plays one agent on one split's first 64 mazes, each ``plays`` times; returns ``(name, split, result)``.
 
     Maze ``i``'s game is seeded with ``seed * 1000 + i`` (Doom's random draws:
     the spawn heading, Two-colour's items), so ``seed`` gives other episodes
     of the same mazes: what the score varies by from sampling alone.
+    ``shift``: the agent sees ViZDoom's frames moved that many pixels
+    sideways (0: as released), the probe's scale in closed loop: how far a
+    score moves for a change no one would call an engine's.
     """
-    name, split, checkout, seed, plays_per_maze = job
+    name, split, checkout, seed, plays_per_maze, shift = job
     torch.set_num_threads(1)
     info = paper_agents.get(name)
     _, agent, _ = paper_agents.load(name, paper_dir=checkout)
@@ -109,7 +113,7 @@ def play(job: tuple[str, str, str, int, int]) -> tuple[str, str, dict]:
         starts = torch.ones(len(games), dtype=torch.bool)
         live = list(range(len(games)))
         while live:
-            frames = torch.from_numpy(np.stack([_frame(games[i]) for i in live]))
+            frames = torch.from_numpy(np.stack([np.roll(_frame(games[i]), shift, axis=1) for i in live]))
             with torch.no_grad():
                 logits, _, new_hidden = agent.step(agent.features(frames), hidden[live], starts[live])
             hidden[live] = new_hidden
@@ -135,7 +139,7 @@ def play(job: tuple[str, str, str, int, int]) -> tuple[str, str, dict]:
         "mean_return": float(np.mean([e["return"] for e in episodes])),
         "mean_length": float(np.mean([e["length"] for e in episodes])),
         "configs": sorted(e["config_index"] for e in episodes),
-        "seed": seed, "plays_per_config": plays_per_maze,
+        "seed": seed, "plays_per_config": plays_per_maze, "frame_shift": shift,
         # Each episode's (configuration, metric in the table's units, agent steps): for paper_table's intervals.
         "per_episode": sorted((e["config_index"], e["value"], e["length"]) for e in episodes),
     }
@@ -343,6 +347,9 @@ def main() -> None:
     parser.add_argument("--processes", type=int, default=None, help="default: one per core")
     parser.add_argument("--plays", type=int, default=PLAYS_PER_MAZE, help="episodes per maze (default 2)")
     parser.add_argument("--seed", type=int, default=0, help="maze i's game is seeded with seed * 1000 + i")
+    parser.add_argument("--shift", type=int, default=0, metavar="PIXELS",
+                        help="the agents see ViZDoom's frames moved this many pixels sideways (default 0: as "
+                             "released): how far a score moves for a change that is no engine's")
     parser.add_argument("--picks", metavar="SETTING", default=None,
                         help="instead: a Two-colour agent's right and wrong picks in both engines, by totem colour")
     parser.add_argument("--agreement", metavar="SETTING", default=None,
@@ -381,7 +388,7 @@ def main() -> None:
     results = json.loads(args.out.read_text()) if args.out.exists() else {}  # kept: rerun only what is asked
     if args.plays < 1:
         raise SystemExit(f"error: --plays must be at least 1, got {args.plays}")
-    jobs = [(name, split, str(args.checkout), args.seed, args.plays) for name in names for split in ("train", "test")]
+    jobs = [(name, split, str(args.checkout), args.seed, args.plays, args.shift) for name in names for split in ("train", "test")]
     with mp.get_context("spawn").Pool(args.processes) as pool:
         for name, split, result in pool.imap_unordered(play, jobs):
             info = paper_agents.get(name)
