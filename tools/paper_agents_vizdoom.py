@@ -45,6 +45,7 @@ _POSE = ("POSITION_X", "POSITION_Y", "ANGLE")
 SIZE = (112, 64)
 PLAYS_PER_MAZE = 2
 BATCH = 16  # mazes played side by side (one network batch)
+DEFAULT_OUT = pathlib.Path("runs/paper/vizdoom.json")  # what paper_table --vizdoom reads by default
 
 
 def _game(cfg: pathlib.Path, seed: int = 0, objects: bool = False):
@@ -343,7 +344,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("checkout", type=pathlib.Path, help="a checkout of the released repository")
     parser.add_argument("--only", nargs="+", default=None, metavar="SETTING", help="e.g. labyrinth_9 two_colour_1")
-    parser.add_argument("--out", type=pathlib.Path, default=pathlib.Path("runs/paper/vizdoom.json"))
+    parser.add_argument("--out", type=pathlib.Path, default=DEFAULT_OUT)
     parser.add_argument("--processes", type=int, default=None, help="default: one per core")
     parser.add_argument("--plays", type=int, default=PLAYS_PER_MAZE, help="episodes per maze (default 2)")
     parser.add_argument("--seed", type=int, default=0, help="maze i's game is seeded with seed * 1000 + i")
@@ -388,6 +389,9 @@ def main() -> None:
     results = json.loads(args.out.read_text()) if args.out.exists() else {}  # kept: rerun only what is asked
     if args.plays < 1:
         raise SystemExit(f"error: --plays must be at least 1, got {args.plays}")
+    if args.shift and args.out == DEFAULT_OUT:  # a probe must not stand in for ViZDoom as released
+        raise SystemExit(f"error: --shift {args.shift} plays ViZDoom with moved frames: pass --out FILE other than "
+                         f"{DEFAULT_OUT}")
     jobs = [(name, split, str(args.checkout), args.seed, args.plays, args.shift) for name in names for split in ("train", "test")]
     with mp.get_context("spawn").Pool(args.processes) as pool:
         for name, split, result in pool.imap_unordered(play, jobs):
