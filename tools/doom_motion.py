@@ -1,6 +1,7 @@
-"""The agent's motion per agent step, ViZDoom beside mjmaze, in open space.
+"""The agent's motion per agent step, ViZDoom beside mjmaze, in open space and along a wall.
 
-    python tools/doom_motion.py          # needs ViZDoom: pip install -e ".[bench]"
+    python tools/doom_motion.py              # needs ViZDoom: pip install -e ".[bench]"
+    python tools/doom_motion.py --wall-slide # forward held into a wall at 20, 45 and 70 degrees
 
 Plays the same key sequences (frame skip 4) in ViZDoom's open `health_gathering`
 room and in an empty mjmaze arena (Two-colour at complexity 0) and prints, per
@@ -11,8 +12,11 @@ what `tests/test_labyrinth.py` checks (docs/motion.md).
 
 from __future__ import annotations
 
+import argparse
 import math
 import os
+import pathlib
+import tempfile
 
 import mjmaze
 from mjmaze.tasks import base
@@ -69,7 +73,53 @@ def mjmaze_steps(actions: list[int]) -> list[tuple[float, float]]:
     return steps
 
 
+def wall_slide(angles=(20, 45, 70), steps: int = 12) -> None:
+    """Forward held toward the empty arena's north wall, ``angle`` degrees east of its normal, from 48
+    units away: per agent step, the distance along the wall (units) and how far the agent got toward
+    it, in both engines. The arena is laid out as the released generators lay out theirs
+    (``doom_frames.textmap``: the outer wall is the sector's edge)."""
+    import vizdoom as vzd
+
+    import doom_frames  # tools/, beside this script
+
+    env = doom_frames.empty_arena("stone")
+    config, physics = env.task.config, env.physics
+    half = config.size / 2 * config.cell_size * doom_frames.UNITS
+    for angle in angles:
+        x0, y0, heading = 0.0, half - 48.0, 90 - angle  # Doom's angles: 90 faces north
+        with tempfile.TemporaryDirectory() as folder:
+            wad = pathlib.Path(folder) / "slide.wad"
+            doom_frames.write_wad(wad, doom_frames.textmap(config, (x0, y0, heading), [], doom_frames.STONE))
+            game = doom_frames.released_game(wad, weapon=False,
+                                             variables=[vzd.GameVariable.POSITION_X, vzd.GameVariable.POSITION_Y])
+            doom = []
+            for _ in range(steps):
+                game.make_action([True], 4)
+                doom.append((game.get_game_variable(vzd.GameVariable.POSITION_X),
+                             game.get_game_variable(vzd.GameVariable.POSITION_Y)))
+            game.close()
+        env.reset()
+        physics.show_objects(physics.object_ids([o.name for o in env.task.objects])[1], False)
+        physics.set_agent_pose(x0 * base.MAP_UNIT, y0 * base.MAP_UNIT, math.radians(heading))
+        ours = []
+        for _ in range(steps):
+            env.step(2)  # forward
+            x, y, _ = physics.agent_pose()
+            ours.append((x / base.MAP_UNIT, y / base.MAP_UNIT))
+        print(f"forward into a wall, {angle} degrees from its normal")
+        for label, path in (("  ViZDoom", doom), ("  mjmaze ", ours)):
+            xs = [x0] + [x for x, _ in path]
+            print(label, "along:", " ".join(f"{b - a:5.1f}" for a, b in zip(xs, xs[1:])),
+                  f"| stopped {path[-1][1] - y0:.1f} units toward it")
+    env.task.close()
+
+
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--wall-slide", action="store_true", help="forward held into a wall at an angle instead")
+    if parser.parse_args().wall_slide:
+        wall_slide()
+        return
     for name, actions in SEQUENCES.items():
         print(name)
         for label, steps in (("  ViZDoom", doom_steps(actions)), ("  mjmaze ", mjmaze_steps(actions))):
