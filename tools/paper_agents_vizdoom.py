@@ -386,13 +386,14 @@ def main() -> None:
     if not (args.checkout / paper_agents.MAZES).is_dir():
         raise SystemExit(f"error: {args.checkout} has no {paper_agents.MAZES}: pass a checkout of "
                          f"{paper_agents.RELEASED_REPOSITORY}")
-    results = json.loads(args.out.read_text()) if args.out.exists() else {}  # kept: rerun only what is asked
     if args.plays < 1:
         raise SystemExit(f"error: --plays must be at least 1, got {args.plays}")
     if args.shift and args.out == DEFAULT_OUT:  # a probe must not stand in for ViZDoom as released
         raise SystemExit(f"error: --shift {args.shift} plays ViZDoom with moved frames: pass --out FILE other than "
                          f"{DEFAULT_OUT}")
-    jobs = [(name, split, str(args.checkout), args.seed, args.plays, args.shift) for name in names for split in ("train", "test")]
+    results = json.loads(args.out.read_text()) if args.out.exists() else {}  # kept: rerun only what is asked
+    jobs = [(name, split, str(args.checkout), args.seed, args.plays, args.shift)
+            for name in names for split in ("train", "test")]
     with mp.get_context("spawn").Pool(args.processes) as pool:
         for name, split, result in pool.imap_unordered(play, jobs):
             info = paper_agents.get(name)
