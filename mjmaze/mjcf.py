@@ -216,6 +216,28 @@ def build_xml(
     return ET.tostring(root, encoding="unicode")
 
 
+#: Doom's projection as ViZDoom draws the released 320x180 frames: a focal
+#: length of 120 pixels across and 144 down (Doom's pixels are 1.2x as tall as
+#: wide), as shares of the frame's width and height. mjmaze's frames are those
+#: frames resized (112x64 by default: 42 and 51.2 pixels).
+DOOM_FOCAL_ACROSS = 120 / 320
+DOOM_FOCAL_DOWN = 144 / 180
+
+
+def set_ego_projection(model: mujoco.MjModel, width: int, height: int) -> None:
+    """Gives the ego camera Doom's projection at a ``width`` x ``height`` frame.
+
+    The camera is set by its sensor (the frame, in pixels) and focal lengths,
+    so both renderers (MuJoCo's OpenGL and MuJoCo Warp's) draw ViZDoom's
+    frame resized to this size whatever its aspect (a sensor of the frame's
+    own aspect is never cropped or stretched).
+    """
+    camera = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, EGO_CAMERA)
+    model.cam_sensorsize[camera] = (width, height)
+    model.cam_resolution[camera] = (width, height)
+    model.cam_intrinsic[camera] = (DOOM_FOCAL_ACROSS * width, DOOM_FOCAL_DOWN * height, 0.0, 0.0)
+
+
 def _add_textures(root: ET.Element) -> None:
     """Textures on the wall and floor materials, and light that fades with distance."""
     asset = root.find("asset")

@@ -15,6 +15,7 @@ import collections
 import functools
 import math
 
+import mujoco
 import numpy as np
 from dm_control.rl import control
 from dm_control.suite import base
@@ -83,10 +84,10 @@ class MazeTask(core.MazeRules, base.Task):
         self._model, self._bound_data = model, data
         self._qpos, self._qvel = data.qpos, data.qvel
         self._walls = walls.WallLayout(model, self.layout.grid_size, self.layout.cell_size)
+        mjcf.set_ego_projection(model, self.width, self.height)
         self._renderer = render.EgoRenderer(model, CAMERA, self.width, self.height)
         self._eye = model.cam(CAMERA).pos  # a view into the model: head-bob moves it
-        fovy = math.radians(model.cam(CAMERA).fovy[0])
-        self.horizontal_fov = 2 * math.atan(math.tan(fovy / 2) * self.width / self.height)
+        self.horizontal_fov = horizontal_fov(model, model.cam(CAMERA).id, self.width / self.height)
         self._config_in_model = None
         self._object_ids = physics.object_ids([geom.name for geom in self.objects])[1]
 
@@ -248,6 +249,21 @@ class MazeTask(core.MazeRules, base.Task):
 
 
 @functools.cache
+def horizontal_fov(model: mujoco.MjModel, camera: int, aspect: float) -> float:
+    """The horizontal field of view (radians) of camera ``camera`` drawn at ``aspect`` (width / height).
+
+    A camera given by its sensor and focal lengths (the ego camera: Doom's
+    pixels are taller than wide) fits its sensor to the frame's aspect as
+    MuJoCo's renderers do: the sensor keeps its width when the frame is
+    narrower, its height when wider.
+    """
+    sensor_w, sensor_h = (float(v) for v in model.cam_sensorsize[camera])
+    if sensor_h == 0.0:  # fovy only: square pixels
+        return 2 * math.atan(math.tan(math.radians(float(model.cam_fovy[camera])) / 2) * aspect)
+    sensor_w = min(sensor_w, sensor_h * aspect)
+    return 2 * math.atan(sensor_w / 2 / float(model.cam_intrinsic[camera][0]))
+
+
 def task_class(rules_class: type) -> type:
     """The dm_control task class of a scenario: ``rules_class`` itself if it is a :class:`MazeTask`,
     else ``rules_class`` joined with :class:`MazeTask` (cached: one class per scenario)."""

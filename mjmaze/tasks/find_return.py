@@ -17,6 +17,10 @@ Arguments
 Metric
     ``success``: target found and return reached; ``target_found``.
 Version History
+    * v2 (2026-11-26): Doom's projection: pixels 1.2x as tall as wide (a
+      vertical focal length 1.2x the horizontal, as ViZDoom draws the released
+      frames), so walls and things stand 1.2x as tall in the frame as in the
+      earlier versions' square pixels (docs/look.md, "Projection").
     * v1 (2026-11-25): no pistol drawn: the released maps' ENTER scripts clear
       the inventory, so ViZDoom never drew one (found with the paper's agents).
     * v0 (2026-11-23): initial release; frames, motion and rules calibrated
@@ -97,7 +101,7 @@ class FindReturn(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="find_return",
     task=FindReturn,
-    gym_id="mjmaze/FindReturn-v1",
+    gym_id="mjmaze/FindReturn-v2",
     seed_code=2,
     difficulty="size",
     difficulties=SIZES,

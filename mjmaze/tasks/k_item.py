@@ -22,6 +22,10 @@ The collection order is item kind 1, then 2, ... by the released files' colour
 codes: green, red, blue, cyan, magenta, yellow, then two greys, which also
 differ in shape (:data:`KINDS`).
 Version History
+    * v2 (2026-11-26): Doom's projection: pixels 1.2x as tall as wide (a
+      vertical focal length 1.2x the horizontal, as ViZDoom draws the released
+      frames), so walls and things stand 1.2x as tall in the frame as in the
+      earlier versions' square pixels (docs/look.md, "Projection").
     * v1 (2026-11-25): no pistol drawn: the released maps' ENTER scripts clear
       the inventory, so ViZDoom never drew one (found with the paper's agents).
     * v0 (2026-11-23): initial release; frames, motion and rules calibrated
@@ -125,7 +129,7 @@ class KItem(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="k_item",
     task=KItem,
-    gym_id="mjmaze/KItem-v1",
+    gym_id="mjmaze/KItem-v2",
     seed_code=3,
     difficulty="num_items",
     difficulties=NUM_ITEMS,

@@ -16,6 +16,10 @@ Arguments
 Metric
     ``success``: whether the exit was reached (success rate = mean over episodes).
 Version History
+    * v3 (2026-11-26): Doom's projection: pixels 1.2x as tall as wide (a
+      vertical focal length 1.2x the horizontal, as ViZDoom draws the released
+      frames), so walls and things stand 1.2x as tall in the frame as in the
+      earlier versions' square pixels (docs/look.md, "Projection").
     * v2 (2026-11-25): the exit shows the green armour's sprite as bands (grey
       plates, the vivid green chest, a dark lower edge) around the same mean
       colour; the released agents' episodes were longest where the olive
@@ -84,7 +88,7 @@ class Labyrinth(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="labyrinth",
     task=Labyrinth,
-    gym_id="mjmaze/Labyrinth-v2",
+    gym_id="mjmaze/Labyrinth-v3",
     seed_code=1,
     difficulty="size",
     difficulties=SIZES,

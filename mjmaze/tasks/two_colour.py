@@ -36,6 +36,10 @@ Arguments
 Metric
     ``duration``: tics survived (max 2100); also ``health`` and ``totem_green``.
 Version History
+    * v3 (2026-11-26): Doom's projection: pixels 1.2x as tall as wide (a
+      vertical focal length 1.2x the horizontal, as ViZDoom draws the released
+      frames), so walls and things stand 1.2x as tall in the frame as in the
+      earlier versions' square pixels (docs/look.md, "Projection").
     * v2 (2026-11-25): grey ``STONE2`` walls, as the released generator writes
       them (``-v1`` drew its base map's green-grey ``GSTONE1``); an imported
       layout that spawns the agent on the totem's spot has no totem, as in
@@ -322,7 +326,7 @@ class TwoColour(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="two_colour",
     task=TwoColour,
-    gym_id="mjmaze/TwoColour-v2",
+    gym_id="mjmaze/TwoColour-v3",
     seed_code=4,
     difficulty="complexity",
     difficulties=COMPLEXITIES,
