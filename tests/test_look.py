@@ -53,6 +53,27 @@ def test_walls_are_as_dim_as_vizdooms_and_brighter_near_the_eye():
     env.task.close()
 
 
+@pytest.mark.parametrize("distance, doom_rows", [(2.0, 25.6), (3.0, 17.1), (4.0, 12.8)])
+def test_a_wall_stands_as_tall_in_the_frame_as_in_vizdooms(distance, doom_rows):
+    # ViZDoom draws a 1 m (128-unit) wall d m ahead 128 * 144 / (128 d) of its 180 rows high
+    # (a focal length of 144 px down against 120 across: Doom's pixels are 1.2x as tall
+    # as wide; python tools/doom_frames.py --projection), 0.8 * 64 / d of mjmaze's 64.
+    # Square pixels drew it 1.2x too short (the ids before Labyrinth-v3).
+    env = empty_room(palette.SLIME_ROOM)
+    centre = frame_at(env, env.task.config.size - walls.WALL_THICKNESS / 2 - distance, 0.0, 0.0)[:, 50:62]
+    env.task.close()
+    red, green, blue = (centre[..., k] for k in range(3))
+    wall = (green - red < 8) & (blue - red < 6)  # neither the green floor nor the blue ceiling
+    rows = wall.mean(axis=1).sum()
+    assert rows == pytest.approx(doom_rows, abs=1.5)
+
+
+def test_the_ego_camera_sees_dooms_106_degrees_across():
+    env = empty_room(palette.STONE_ROOM)
+    assert np.degrees(env.task.horizontal_fov) == pytest.approx(2 * np.degrees(np.arctan(160 / 120)), abs=0.01)
+    env.task.close()
+
+
 def test_two_colour_walls_are_the_released_grey_stone2():
     # The released generator writes every side STONE2, replacing its base map's green-grey
     # GSTONE1: a Two-colour wall is as grey as Labyrinth's (ViZDoom: 38 grey 1 m ahead).

@@ -5,6 +5,7 @@
     python tools/doom_frames.py --flashes    # ViZDoom's red (hurt) and gold (pickup) flashes, tic by tic
     python tools/doom_frames.py --contrast   # how much Two-colour's items stand out, 1-4 m ahead
     python tools/doom_frames.py --armour-parts  # the armours' coloured parts, 1-3 m ahead (Two-colour's items)
+    python tools/doom_frames.py --projection    # ViZDoom's focal lengths across and down, beside mjmaze's
     python tools/doom_frames.py --two-colour RELEASED_REPO/scenarios/basefiles/two_color_basefile.wad
                                             # the released Two-colour script played: health changes, tics survived
 
@@ -334,6 +335,43 @@ def calibrate() -> None:
     env.task.close()
 
 
+def projection() -> None:
+    """Prints ViZDoom's focal lengths (pixels of the released 320x180 frame) beside mjmaze's ego camera's.
+
+    Down: the rows a wall 2 and 3 m ahead spans (between the slime room's blue
+    ceiling and green floor) against its 128 units. Across: the centre column of
+    a tall red column 1-2 m off the view axis. mjmaze's are its camera's focal
+    lengths at the same frame (``mjmaze.mjcf.set_ego_projection``).
+    """
+    env = empty_arena("slime", pistol=False)
+    config = env.task.config
+    edge = config.size * config.cell_size / 2 * UNITS  # the released outer wall: the sector's edge
+    down = []
+    for distance in (256, 384):
+        screen = doom_tics(textmap(config, (edge - distance, 0.0, 0), [], SLIME), weapon=False, resize=False)[0][0]
+        centre = screen[:, 150:170].astype(int)
+        floor = ((centre[..., 1] - centre[..., 0]) > 10).mean(axis=1) > 0.5
+        ceiling = ((centre[..., 2] - centre[..., 0]) > 5).mean(axis=1) > 0.5
+        top, bottom = np.flatnonzero(ceiling).max() + 1, np.flatnonzero(floor).min()
+        down.append((bottom - top) * distance / 128)
+    across = []
+    for ahead, side in ((256, 128), (256, -128), (384, 256)):
+        _, masks = doom_tics(textmap(config, (0.0, 0.0, 0), [Thing(ahead, side, RED_COLUMN)], SLIME),
+                             weapon=False, resize=False)
+        columns = np.flatnonzero(masks[0].any(axis=0))
+        across.append((160 - (columns.min() + columns.max() + 1) / 2) * ahead / side)
+    env.task.close()
+    ours = mjmaze.load("labyrinth", task_kwargs={"size": 5, "width": 320, "height": 180})
+    ours.reset()
+    model, camera = ours.physics.model.ptr, ours.physics.model.ptr.cam(base.CAMERA).id
+    fx, fy = model.cam_intrinsic[camera][:2] / model.cam_sensorsize[camera] * (320, 180)
+    ours.task.close()
+    print(f"ViZDoom, 320x180: focal {np.mean(across):.1f} px across ({', '.join(f'{v:.1f}' for v in across)}), "
+          f"{np.mean(down):.1f} px down ({', '.join(f'{v:.1f}' for v in down)}): "
+          f"pixels {np.mean(down) / np.mean(across):.3f}x as tall as wide")
+    print(f"mjmaze's ego camera at 320x180: {fx:.1f} px across, {fy:.1f} px down")
+
+
 def armour_parts() -> None:
     """Prints the colour of the armours' coloured parts, 1 / 2 / 3 m ahead in the empty slime arena.
 
@@ -492,9 +530,12 @@ def main() -> None:
                         help="play the released Two-colour script (two_color_basefile.wad of the released repo)")
     parser.add_argument("--contrast", action="store_true", help="print how much Two-colour's items stand out")
     parser.add_argument("--armour-parts", action="store_true", help="print the armours' coloured parts, 1-3 m ahead")
+    parser.add_argument("--projection", action="store_true", help="print ViZDoom's focal lengths beside mjmaze's")
     parser.add_argument("--episodes", type=int, default=32, help="episodes for --two-colour")
     args = parser.parse_args()
-    if args.armour_parts:
+    if args.projection:
+        projection()
+    elif args.armour_parts:
         armour_parts()
     elif args.contrast:
         item_contrast()
