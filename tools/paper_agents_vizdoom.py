@@ -1,7 +1,7 @@
 """The paper's agents in ViZDoom, as released: the other side of ``python -m mjmaze.train.paper_table``.
 
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT [--only labyrinth_9 two_colour_1] [--out FILE]
-    python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --agreement labyrinth_7   # the same action at the same pose?
+    python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --agreement labyrinth_7   # the same action at the same pose? how far apart are the frames?
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --agreement two_colour_1  # ... with ViZDoom's items placed
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --picks two_colour_5      # right and wrong picks, both engines
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --shift 1 --out F         # frames moved 1 px: the probe's scale
@@ -146,11 +146,14 @@ def play(job: tuple[str, str, str, int, int, int]) -> tuple[str, str, dict]:
     }
 
 
-def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False) -> tuple[float, float]:
+def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False) -> tuple[float, float, dict]:
     """How often the agent chooses, on mjmaze's frame, the action it chose on ViZDoom's frame at the same pose.
 
-    Returns that share and, for scale, the share on ViZDoom's own frames moved
-    one pixel sideways (the agent's choices are that sensitive to any change).
+    Returns that share, for scale the share on ViZDoom's own frames moved
+    one pixel sideways (the agent's choices are that sensitive to any change),
+    and how far the two engines' frames are apart at those poses: the mean
+    grey difference per pixel, in 8x8 blocks (what is where, textures averaged
+    out) and per column (:func:`frame_gaps`).
 
     The agent plays the first ``mazes`` test mazes greedily in ViZDoom; each of
     its poses is then set in mjmaze (head-bob off: its phase is ViZDoom's own)
@@ -176,7 +179,7 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
     folder = pathlib.Path(checkout) / paper_agents.MAZES / info.maze_folder / "test"
     env = mjmaze.load(info.scenario, task_kwargs={**info.task_kwargs, "layouts": str(folder), "head_bob": False})
     task = env.task
-    same, same_shifted = [], []
+    same, same_shifted, gaps = [], [], []
     for index in range(mazes):
         maze = json.loads((folder / f"custom_scenario{index:03d}.json").read_text())
         centre = np.mean(np.array(maze["exterior"], dtype=float), axis=0)  # mjmaze centres the maze on (0, 0)
@@ -191,8 +194,9 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
                 logits, _, hidden = agent.step(agent.features(torch.from_numpy(_frame(game)[None])), hidden, start)
             start[:] = False
             action = int(logits.argmax())
+            frame = _frame(game)
             path.append((*_metres(x, y, centre), math.radians(angle), action, things, tuple(flashes),
-                         np.roll(_frame(game), 1, axis=1)))
+                         frame, np.roll(frame, 1, axis=1)))
             for _ in range(FRAME_SKIP):  # tic by tic, to follow the flash counters
                 game.make_action(LIMITED_ACTIONS[action], 1)
                 flashes = [max(count - 1, 0) for count in flashes]
@@ -210,12 +214,13 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
             env.reset()
         hidden, start = agent.initial_state(1), torch.ones(1, dtype=torch.bool)
         shifted_hidden = agent.initial_state(1)
-        for x, y, yaw, action, things, flashes, shifted in path:
+        for x, y, yaw, action, things, flashes, doom, shifted in path:
             if two_colour:
                 _place_two_colour_things(task, env.physics, things, flashes, hide_items)
             env.physics.set_agent_pose(x, y, yaw)
             env.physics.forward()
             frame = np.ascontiguousarray(task.get_observation(env.physics)["pixels"])
+            gaps.append(frame_gaps(doom, frame))
             with torch.no_grad():
                 logits, _, hidden = agent.step(agent.features(torch.from_numpy(frame[None])), hidden, start)
                 shifted_logits, _, shifted_hidden = agent.step(agent.features(torch.from_numpy(shifted[None])),
@@ -224,7 +229,20 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
             same.append(int(logits.argmax()) == action)
             same_shifted.append(int(shifted_logits.argmax()) == action)
     task.close()
-    return float(np.mean(same)), float(np.mean(same_shifted))
+    gap = dict(zip(("pixel", "block", "column"), np.mean(gaps, axis=0).tolist()))
+    return float(np.mean(same)), float(np.mean(same_shifted)), gap
+
+
+def frame_gaps(doom: np.ndarray, ours: np.ndarray, block: int = 8) -> tuple[float, float, float]:
+    """Mean absolute grey difference of two ``(H, W, 3)`` frames: per pixel, in ``block`` x ``block`` means, per column."""
+    a, b = (frame.astype(np.float64).mean(axis=2) for frame in (doom, ours))
+    h, w = a.shape[0] // block, a.shape[1] // block
+
+    def blocks(grey: np.ndarray) -> np.ndarray:
+        return grey[: h * block, : w * block].reshape(h, block, w, block).mean(axis=(1, 3))
+
+    return (float(np.abs(a - b).mean()), float(np.abs(blocks(a) - blocks(b)).mean()),
+            float(np.abs(a.mean(axis=0) - b.mean(axis=0)).mean()))
 
 
 def picks(name: str, checkout: str, mazes: int = 32) -> dict[str, dict]:
@@ -355,17 +373,22 @@ def main() -> None:
                         help="instead: a Two-colour agent's right and wrong picks in both engines, by totem colour")
     parser.add_argument("--agreement", metavar="SETTING", default=None,
                         help="instead: how often a Labyrinth or Two-colour agent acts alike on both engines' frames "
-                             "at the same poses")
+                             "at the same poses, and how far apart the engines' frames are there")
+    parser.add_argument("--mazes", type=int, default=8, help="test mazes for --agreement (default 8)")
     args = parser.parse_args()
     if args.agreement:
         scenario = paper_agents.get(args.agreement).scenario
         if scenario not in ("labyrinth", "two_colour"):
             raise SystemExit("error: --agreement takes a Labyrinth or Two-colour agent (labyrinth_7 .. two_colour_7)")
-        share, shifted = agreement(args.agreement, str(args.checkout))
-        print(f"{args.agreement}: the same action at {share:.1%} of the poses of its ViZDoom episodes (first 8 test "
-              f"mazes); on ViZDoom's own frames moved 1 pixel sideways: {shifted:.1%}")
+        if args.mazes < 1:
+            raise SystemExit(f"error: --mazes must be 1 or more, got {args.mazes}")
+        share, shifted, gap = agreement(args.agreement, str(args.checkout), mazes=args.mazes)
+        print(f"{args.agreement}: the same action at {share:.1%} of the poses of its ViZDoom episodes (first "
+              f"{args.mazes} test mazes); on ViZDoom's own frames moved 1 pixel sideways: {shifted:.1%}")
+        print(f"  the frames' mean grey difference at those poses: {gap['pixel']:.2f} per pixel, {gap['block']:.2f} "
+              f"in 8x8 blocks, {gap['column']:.2f} per column")
         if scenario == "two_colour":
-            hidden = agreement(args.agreement, str(args.checkout), hide_items=True)[0]
+            hidden = agreement(args.agreement, str(args.checkout), mazes=args.mazes, hide_items=True)[0]
             print(f"  with mjmaze's items hidden: {hidden:.1%}")
         return
     if args.picks:
