@@ -248,7 +248,6 @@ class MazeTask(core.MazeRules, base.Task):
         self._bound_data = None
 
 
-@functools.cache
 def horizontal_fov(model: mujoco.MjModel, camera: int, aspect: float) -> float:
     """The horizontal field of view (radians) of camera ``camera`` drawn at ``aspect`` (width / height).
 
@@ -264,6 +263,7 @@ def horizontal_fov(model: mujoco.MjModel, camera: int, aspect: float) -> float:
     return 2 * math.atan(sensor_w / 2 / float(model.cam_intrinsic[camera][0]))
 
 
+@functools.cache
 def task_class(rules_class: type) -> type:
     """The dm_control task class of a scenario: ``rules_class`` itself if it is a :class:`MazeTask`,
     else ``rules_class`` joined with :class:`MazeTask` (cached: one class per scenario)."""
