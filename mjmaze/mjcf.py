@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import importlib.resources
+import math
 import pathlib
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
@@ -222,6 +223,8 @@ def build_xml(
 #: frames resized (112x64 by default: 42 and 51.2 pixels).
 DOOM_FOCAL_ACROSS = 120 / 320
 DOOM_FOCAL_DOWN = 144 / 180
+#: The ego camera's horizontal field of view (radians) at any frame size: Doom's 106.26 degrees.
+EGO_HORIZONTAL_FOV = 2 * math.atan(0.5 / DOOM_FOCAL_ACROSS)
 
 
 def set_ego_projection(model: mujoco.MjModel, width: int, height: int) -> None:

@@ -15,7 +15,6 @@ import collections
 import functools
 import math
 
-import mujoco
 import numpy as np
 from dm_control.rl import control
 from dm_control.suite import base
@@ -87,7 +86,7 @@ class MazeTask(core.MazeRules, base.Task):
         mjcf.set_ego_projection(model, self.width, self.height)
         self._renderer = render.EgoRenderer(model, CAMERA, self.width, self.height)
         self._eye = model.cam(CAMERA).pos  # a view into the model: head-bob moves it
-        self.horizontal_fov = horizontal_fov(model, model.cam(CAMERA).id, self.width / self.height)
+        self.horizontal_fov = mjcf.EGO_HORIZONTAL_FOV
         self._config_in_model = None
         self._object_ids = physics.object_ids([geom.name for geom in self.objects])[1]
 
@@ -246,21 +245,6 @@ class MazeTask(core.MazeRules, base.Task):
             self._renderer.close()
             self._renderer = None
         self._bound_data = None
-
-
-def horizontal_fov(model: mujoco.MjModel, camera: int, aspect: float) -> float:
-    """The horizontal field of view (radians) of camera ``camera`` drawn at ``aspect`` (width / height).
-
-    A camera given by its sensor and focal lengths (the ego camera: Doom's
-    pixels are taller than wide) fits its sensor to the frame's aspect as
-    MuJoCo's renderers do: the sensor keeps its width when the frame is
-    narrower, its height when wider.
-    """
-    sensor_w, sensor_h = (float(v) for v in model.cam_sensorsize[camera])
-    if sensor_h == 0.0:  # fovy only: square pixels
-        return 2 * math.atan(math.tan(math.radians(float(model.cam_fovy[camera])) / 2) * aspect)
-    sensor_w = min(sensor_w, sensor_h * aspect)
-    return 2 * math.atan(sensor_w / 2 / float(model.cam_intrinsic[camera][0]))
 
 
 @functools.cache
