@@ -1,4 +1,4 @@
-"""What Doom draws besides the 3D scene, for both renderers: head-bob, the pistol, the flashes.
+"""How Doom draws beside the 3D scene, for both renderers: its light, head-bob, the pistol, the flashes.
 
 The CPU renderer (:class:`mjmaze.render.EgoRenderer`, one frame) and the
 MuJoCo Warp backend (:mod:`mjmaze.warp`, every world's frame at once) draw the
@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from mjmaze import mjcf, rules
+from mjmaze import mjcf, palette, rules, walls
 
 # Head-bob: Doom's P_CalcHeight and P_BobWeapon. Walking swings the eye by half
 # the "bob", min(v^2 / 4, 16) map units with v the speed after the tic's thrust
@@ -115,3 +115,86 @@ def tint(xp, frames, rgb, alpha):
 def flash(xp, frames, damage_count, bonus_count):
     """``frames`` ``(B, H, W, 3)`` under each env's flash, from its counters ``(B,)`` (:func:`mjmaze.rules.flash`)."""
     return tint(xp, frames, *rules.flash(xp, damage_count, bonus_count))
+
+
+# Doom's light (palette.DepthLight), applied to a frame GL or MuJoCo Warp drew
+# by ambient light alone: each pixel's surface is found from where it lies in
+# the maze (its depth, the camera's pose, the walls' grid), then its colour is
+# scaled by the gain of that surface at that depth, read from a table over
+# inverse depth (interpolating per pixel cost several times more on a CPU).
+NORTH_SOUTH_WALL, EAST_WEST_WALL, FLOOR, CEILING, THING = range(5)
+_LIGHT_BINS = 1024  # table rows over inverse depth, 0 .. 1 / _NEAREST
+_NEAREST = 0.1  # metres; nearer pixels take this depth's gain
+_ON_PLANE = 0.02  # metres from a wall face, the floor or the ceiling that still count as on it
+
+
+def light_table() -> np.ndarray:
+    """``(5, bins)`` float32: each surface's gain (:data:`NORTH_SOUTH_WALL` ...) over inverse depth."""
+    depth = 1 / ((np.arange(_LIGHT_BINS) + 0.5) / (_LIGHT_BINS * _NEAREST))
+    # Things: the lamp, head-on (palette.THING_LAMP); nearer than ~0.36 m it
+    # saturated as GL's light does, at 1 (which also keeps every lit colour
+    # within 255: GL draws none above 255 x AMBIENT before Doom's light).
+    thing = np.minimum(1 + palette.THING_LAMP / (0.05 + depth) / palette.AMBIENT, 1 / palette.AMBIENT)
+    light = palette.NORTH_SOUTH_WALL_LIGHT, palette.EAST_WEST_WALL_LIGHT, palette.FLOOR_LIGHT, palette.CEILING_LIGHT
+    return np.stack([surface.gain(depth) for surface in light] + [thing]).astype(np.float32)
+
+
+def _surface_of_code(code: int) -> int:
+    """The surface of a pixel coded ``east_west + 2 thing + 4 floor + 8 ceiling`` (floor and ceiling first)."""
+    if code & 4:
+        return FLOOR
+    if code & 8:
+        return CEILING
+    if code & 2:
+        return THING
+    return EAST_WEST_WALL if code & 1 else NORTH_SOUTH_WALL
+
+
+class DoomLight:
+    """Doom's light on ``height x width`` frames of a maze of ``grid_size`` cells of ``cell_size`` metres.
+
+    Made once per env (or batch) and device; call it on every frame.
+    """
+
+    def __init__(self, xp, device, width: int, height: int, grid_size: int, cell_size: float):
+        self._xp = xp
+        # Tangents of each column's and row's ray (right, up) in Doom's projection (mjcf.set_ego_projection).
+        self._right = xp.asarray((np.arange(width) + 0.5 - width / 2) / (mjcf.DOOM_FOCAL_ACROSS * width),
+                                 dtype=xp.float32, device=device)
+        self._up = xp.asarray((height / 2 - np.arange(height) - 0.5) / (mjcf.DOOM_FOCAL_DOWN * height),
+                              dtype=xp.float32, device=device)
+        # The gains by (code, inverse depth), each repeated for the three channels:
+        # numpy multiplies by a gain broadcast over the channels several times slower.
+        gains = light_table()[[_surface_of_code(code) for code in range(16)]]
+        self._gains = xp.asarray(np.repeat(gains.reshape(-1, 1), 3, axis=1), device=device)
+        self._cell, self._half_grid = float(cell_size), grid_size / 2
+        self._face = walls.WALL_THICKNESS / 2 / self._cell  # a wall face's offset from its grid line, in cells
+        self._on_face = _ON_PLANE / self._cell
+
+    def _off_wall_face(self, cells):
+        """Cells from a coordinate (in cells from the grid's first line) to the nearest wall face across it."""
+        xp = self._xp
+        return xp.abs(xp.abs(cells - xp.round(cells)) - self._face)
+
+    def __call__(self, frames, depth, eye, yaw):
+        """``frames`` (uint8 ``(B, H, W, 3)``) in Doom's light: new frames.
+
+        ``depth``: ``(B, H, W)`` metres along the view axis; ``eye``: the
+        camera's ``(B, 3)`` position; ``yaw``: its ``(B,)`` heading (radians).
+        """
+        xp = self._xp
+        yaw, eye = xp.astype(yaw, xp.float32)[:, None, None], xp.astype(eye, xp.float32)[:, None, None, :]
+        cos, sin, right = xp.cos(yaw), xp.sin(yaw), self._right
+        # Where each pixel lies, in cells from the grid's first lines: on a wall
+        # face across x (a wall running north-south), across y, or neither (a thing).
+        x = eye[..., 0] / self._cell + self._half_grid + depth * ((cos + right * sin) / self._cell)
+        y = eye[..., 1] / self._cell + self._half_grid + depth * ((sin - right * cos) / self._cell)
+        off_x, off_y = self._off_wall_face(x), self._off_wall_face(y)
+        code = xp.astype(off_y < off_x, xp.int32) + 2 * xp.astype(xp.minimum(off_x, off_y) > self._on_face, xp.int32)
+        # The floor and the ceiling: pixels as deep as their row's ray meets the plane.
+        up = self._up[:, None]
+        plane = xp.where(up < 0, (eye[..., 2] - _ON_PLANE) / -up, (walls.WALL_HEIGHT - _ON_PLANE - eye[..., 2]) / up)
+        code = xp.where(depth > plane, xp.where(up < 0, 4, 8), code)
+        bins = xp.astype(rules.at_most(xp, (_LIGHT_BINS * _NEAREST) / depth, _LIGHT_BINS - 1), xp.int32)
+        gain = xp.take(self._gains, xp.reshape(code * _LIGHT_BINS + bins, (-1,)), axis=0)
+        return xp.astype(xp.astype(frames, xp.float32) * xp.reshape(gain, frames.shape) + 0.5, xp.uint8)

@@ -40,7 +40,6 @@ ARENA_BODY = "arena"  # build_xml's batch arena: the body holding what differs b
 COLLISION_SUFFIX = "_collision"  # build_xml's batch arena: a colliding object's blocking twin
 OVERHEAD_CAMERA = "overhead"
 OVERHEAD_HEIGHT = 10.0
-LAMP = "lamp"
 CEILING_GROUP = 2  # a geom group drawn in the agent's view, left out of top-down maps (mjmaze.render)
 CEILING_HALF_THICKNESS = 0.01
 EYE_HEIGHT = 0.32  # the ego camera's height (xml_templates/arena.xml)
@@ -242,7 +241,7 @@ def set_ego_projection(model: mujoco.MjModel, width: int, height: int) -> None:
 
 
 def _add_textures(root: ET.Element) -> None:
-    """Textures on the wall and floor materials, and light that fades with distance."""
+    """Textures on the wall and floor materials, and GL's even light (Doom's comes after)."""
     asset = root.find("asset")
     for name in ("wall", "floor"):
         # builtin="flat" only sizes the texture: paint_textures fills it.
@@ -262,32 +261,21 @@ def _add_textures(root: ET.Element) -> None:
     # texture coordinates in metres.
     asset.find("material[@name='floor']").set("texuniform", "true")
     asset.find("material[@name='floor']").set("texrepeat", "1 1")
-    add_distance_falloff(root)
+    _ambient_light(root)
 
 
-def add_distance_falloff(root: ET.Element) -> None:
-    """Light that is brighter near the agent's eye, as Doom's at the released sector light.
+def _ambient_light(root: ET.Element) -> None:
+    """GL's light for the textured style: ambient only, the same on every surface.
 
-    Doom darkens what is far ("light diminishing"); at the sector light the
-    released maps leave at its default (160), ViZDoom draws a ``STONE2`` wall
-    27 + 12 / d grey levels bright ``d`` map cells ahead: a floor of light
-    everywhere and a boost near the eye. Here the headlight gives the floor
-    (ambient only: directional, not attenuated) and a point lamp at the eye the
-    boost (diffuse, attenuated by 1 / (0.05 + d)). Both are computed at vertices,
-    so they cost next to nothing per pixel (fog, per pixel, cost about twice as
-    much on llvmpipe); the wall mesh is cut into pieces of at most 1 m and the
-    floor is a grid of :data:`LIT_QUAD` quads, so the boost is smooth.
+    Doom lights a pixel by its depth along the view axis and a wall by its
+    side, never by the angle it is seen at (:class:`mjmaze.palette.DepthLight`);
+    fixed-function GL's lamps light by angle and distance, at vertices. So GL
+    draws the scene evenly and the renderers apply Doom's light to the frame
+    with its depth (:class:`mjmaze.look.DoomLight`).
     """
-    visual = root.find("visual")
-    headlight = visual.find("headlight")
+    headlight = root.find("visual/headlight")
     headlight.set("ambient", f"{palette.AMBIENT} {palette.AMBIENT} {palette.AMBIENT}")
     headlight.set("diffuse", "0 0 0")
-    agent = root.find("worldbody/body[@name='agent']")
-    ET.SubElement(
-        agent, "light", name=LAMP, pos=f"0 0 {EYE_HEIGHT}", dir="1 0 0", directional="false", castshadow="false",
-        attenuation=" ".join(map(str, palette.LAMP_ATTENUATION)), cutoff="180", ambient="0 0 0",
-        diffuse=f"{palette.LAMP_DIFFUSE} {palette.LAMP_DIFFUSE} {palette.LAMP_DIFFUSE}", specular="0 0 0",
-    )
 
 
 def paint_textures(model: mujoco.MjModel, objects: Sequence[ObjectGeom] = ()) -> None:

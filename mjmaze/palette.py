@@ -1,10 +1,11 @@
 """Doom's colours and light as ViZDoom draws the released maps, and the textures that carry them.
 
 Every number here was measured in ViZDoom against mjmaze's frames
-(``python tools/doom_frames.py --calibrate``; docs/look.md): the rooms' mean
-colours, the things' colours, the armour sprite's bands, the light that fades
-with distance, and the grey texture patterns with the gains that keep each
-surface's mean colour. :mod:`mjmaze.mjcf` writes them into the arena.
+(``python tools/doom_frames.py --calibrate`` and ``--light``; docs/look.md):
+the rooms' mean colours, the things' colours, the armour sprite's bands,
+Doom's light over depth, and the grey texture patterns with the gains that
+keep each surface's mean colour. :mod:`mjmaze.mjcf` writes them into the
+arena; :class:`mjmaze.look.DoomLight` applies the light.
 """
 
 from __future__ import annotations
@@ -18,10 +19,9 @@ class Room:
     """The colours (0-1) of a scenario's walls, floor and ceiling.
 
     They make mjmaze's frames show the mean colours of the released scenario's
-    Doom textures as ViZDoom draws them at the released sector light (160):
-    walls and floor are lit (:func:`mjmaze.mjcf.add_distance_falloff`), the ceiling is
-    seen in its colour as is. ``python tools/doom_frames.py --calibrate`` prints
-    ViZDoom's colours beside mjmaze's (docs/look.md).
+    Doom textures as ViZDoom draws them at the released sector light (160),
+    under Doom's light (:class:`DepthLight`). ``python tools/doom_frames.py
+    --calibrate`` prints ViZDoom's colours beside mjmaze's (docs/look.md).
     """
 
     wall: tuple[float, float, float]
@@ -69,12 +69,58 @@ GREEN_ARMOUR_BANDS = (
     (0.28, (0.199, 0.422, 0.158)),
     (0.20, (0.157, 0.136, 0.074)),
 )
-#: Ambient light everywhere, then a lamp at the eye adding ``LAMP_DIFFUSE x cos / (0.05 + d)``
-#: at ``d`` metres: Doom's light diminishing at sector light 160, which ViZDoom
-#: draws as 27 + 12 / d grey levels on a ``STONE2`` wall ``d`` map cells ahead.
+#: The light GL draws every surface with: ambient only, no lamp. Doom's light
+#: (below) is applied to the frame afterwards, per pixel, by its depth
+#: (:func:`mjmaze.look.doom_light`); mjmaze's surfaces drawn so show
+#: ``255 x colour x AMBIENT`` grey levels before it.
 AMBIENT = 0.28
-LAMP_DIFFUSE = 0.30
-LAMP_ATTENUATION = (0.05, 1.0, 0.0)
+
+
+@dataclasses.dataclass(frozen=True)
+class DepthLight:
+    """Doom's light on a kind of surface: grey levels over depth, as ViZDoom draws them.
+
+    Doom lights a pixel by its depth along the view axis alone ("light
+    diminishing"), never by the angle it is seen at, and gives walls running
+    north-south ("vertical" map lines, seen facing east or west) more light
+    than walls running east-west (ZDoom's ``WallVertLight`` +8 /
+    ``WallHorizLight`` -8 light levels). ``grey`` is what ViZDoom draws of
+    :data:`STONE_ROOM`'s surface (its mean grey; the floor's red channel)
+    ``depth`` metres ahead at the released sector light (160), measured with
+    ``python tools/doom_frames.py --light``; ``unlit`` what mjmaze draws of
+    the same surface before Doom's light. Their ratio is the light's gain,
+    which holds for any room's colours: Doom's light scales a texture's
+    colours whatever they are.
+    """
+
+    depth: tuple[float, ...]
+    grey: tuple[float, ...]
+    unlit: float
+
+    def gain(self, depth: np.ndarray) -> np.ndarray:
+        """The factor on the unlit colour ``depth`` metres ahead (nearest measured value outside the range)."""
+        return np.interp(np.log(depth), np.log(self.depth), self.grey) / self.unlit
+
+
+_WALL_DEPTHS = (0.35, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0)
+#: Walls running north-south (along y): Doom's brighter side.
+NORTH_SOUTH_WALL_LIGHT = DepthLight(
+    _WALL_DEPTHS, (53, 52, 46, 39.5, 36, 33.5, 32, 30.5, 28, 26), 255 * STONE_ROOM.wall[0] * AMBIENT)
+#: Walls running east-west (along x): Doom's darker side, as bright as the other only within ~0.4 m.
+EAST_WEST_WALL_LIGHT = DepthLight(
+    _WALL_DEPTHS, (51, 40, 32, 27.3, 23.5, 20, 19, 17.5, 17, 16.8), 255 * STONE_ROOM.wall[0] * AMBIENT)
+FLOOR_LIGHT = DepthLight(
+    (0.54, 0.66, 0.8, 0.96, 1.2, 1.56, 1.92, 2.52, 3.6, 6.6, 12.0),
+    (63, 56, 52, 45, 40, 35.5, 32, 30, 29.5, 28.8, 28), 255 * STONE_ROOM.floor[0] * AMBIENT)
+#: The ceiling glows in its room colour before Doom's light (:func:`mjmaze.mjcf.build_xml`).
+CEILING_LIGHT = DepthLight(
+    (1.1, 1.37, 1.56, 1.8, 2.16, 2.58, 3.36, 4.68, 9.6),
+    (34, 32, 30, 28.5, 28, 26, 24.5, 23, 22.5), 255 * STONE_ROOM.ceiling[0])
+#: Things (exits, items, pillars, totems): their colours above were measured
+#: beside ViZDoom's with mjmaze's earlier light, a lamp at the eye that added
+#: ``THING_LAMP / (0.05 + d)`` to the ambient light on a surface facing it
+#: ``d`` metres away; they keep that light, seen head-on, at their depth.
+THING_LAMP = 0.30
 TEXTURE_TEXELS = 64  # per side of a texture; one texture covers 1 m x 1 m
 # 1 / the mean grey of each texture (see _brick_texels, _tile_texels).
 TEXTURE_GAIN = {"wall": 1.35, "floor": 1.6}

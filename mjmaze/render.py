@@ -189,8 +189,10 @@ class EgoRenderer:
     context (meshes are per model, and the wall mesh is rewritten per maze).
     """
 
-    def __init__(self, model: mujoco.MjModel, camera: str, width: int, height: int, map_view: bool = False):
-        """``map_view``: for top-down maps, light the scene evenly from straight
+    def __init__(self, model: mujoco.MjModel, camera: str, width: int, height: int, map_view: bool = False,
+                 depth: bool = False):
+        """``depth``: also read each frame's depth (:attr:`depth`, metres along the view axis).
+        ``map_view``: for top-down maps, light the scene evenly from straight
         above instead of with the model's lights (the textured style's lamp sits
         at the agent's eye and fades with distance), and draw no textures, so
         the floor is one colour under drawn paths. What Doom draws over the
@@ -225,6 +227,12 @@ class EgoRenderer:
         self._viewport = mujoco.MjrRect(0, 0, width, height)
         self._buffer = np.empty((height, width, 3), dtype=np.uint8)
         self._frame = self._buffer[::-1]  # bottom-up GL image, flipped without a copy
+        self._depth_buffer = np.empty((height, width), dtype=np.float32) if depth else None
+        #: ``(H, W)`` float32: the last frame's depth in metres along the view axis (with ``depth``).
+        self.depth = np.empty((height, width), dtype=np.float32) if depth else None
+        # GL's depth buffer holds 1/depth rescaled between the near and far clipping planes.
+        near, far = model.vis.map.znear * model.stat.extent, model.vis.map.zfar * model.stat.extent
+        self._near, self._near_over_far = near, near / far
         self._catmask = int(mujoco.mjtCatBit.mjCAT_ALL)
         self._offscreen = int(mujoco.mjtFramebuffer.mjFB_OFFSCREEN)
 
@@ -245,7 +253,9 @@ class EgoRenderer:
             self._light_from_above()
         mujoco.mjr_setBuffer(self._offscreen, self._context)
         mujoco.mjr_render(self._viewport, self._scene, self._context)
-        mujoco.mjr_readPixels(self._buffer, None, self._viewport, self._context)
+        mujoco.mjr_readPixels(self._buffer, self._depth_buffer, self._viewport, self._context)
+        if self._depth_buffer is not None:
+            np.divide(self._near, 1 - self._depth_buffer[::-1] * (1 - self._near_over_far), out=self.depth)
         return self._frame
 
     def segmentation(self, data: mujoco.MjData) -> np.ndarray:

@@ -4,7 +4,7 @@
 gymnasium vector env whose observations, rewards, flags and ``info`` are torch
 tensors on ``device``; reached from the registry by one word::
 
-    envs = gymnasium.make_vec("mjmaze/Labyrinth-v3", num_envs=4096,
+    envs = gymnasium.make_vec("mjmaze/Labyrinth-v4", num_envs=4096,
                               vectorization_mode="vector_entry_point", backend="warp", size=9)
 
 It plays the same task as the CPU envs: the same configurations (splits,
@@ -175,12 +175,13 @@ class MazeBatchEnv(batch.BatchEnv):
         self._timestep = float(mjm.opt.timestep)
         self._actions = torch.tensor(task.actions, dtype=torch.float64, device=dev)  # (A, 2): forward, turn
 
+        textured = task.visual_style == "textured"
         with wp.ScopedDevice(self._wp_device):
             batched = {"geom_pos": n, "geom_rgba": n, "geom_dataid": n} | ({"cam_pos": n} if task.head_bob else {})
             self._model = mjw.put_model(mjm, batch_sizes=batched)
             self._data = mjw.put_data(mjm, mujoco.MjData(mjm), nworld=n, nconmax=_CONTACTS_PER_WORLD, njmax=_CONTACTS_PER_WORLD)
             self._render = mjw.create_render_context(
-                mjm, nworld=n, cam_res=(width, height), render_rgb=True, render_depth=False,
+                mjm, nworld=n, cam_res=(width, height), render_rgb=True, render_depth=textured,
                 render_seg=render_segmentation, use_textures=True, cam_active=[mjcf.EGO_CAMERA],
                 enabled_geom_groups=[0, 1, 2],
             )
@@ -196,6 +197,10 @@ class MazeBatchEnv(batch.BatchEnv):
         self._cam_pos = wp.to_torch(self._model.cam_pos)  # per world with head-bob
         self._camera = mujoco.mj_name2id(mjm, mujoco.mjtObj.mjOBJ_CAMERA, mjcf.EGO_CAMERA)
         self._rgb_packed = wp.to_torch(self._render.rgb_data)
+        self._depth = wp.to_torch(self._render.depth_data).view(n, height, width) if textured else None
+        self._cam_xpos = wp.to_torch(self._data.cam_xpos)
+        self._light = (look.DoomLight(self.xp, dev, width, height, task.layout.grid_size, task.layout.cell_size)
+                       if textured else None)
         self._stream = wp.stream_from_torch(torch.cuda.current_stream(dev)) if dev.type == "cuda" else None
 
         self._seed_keys = torch.zeros(n, dtype=torch.int64, device=dev)
@@ -367,7 +372,9 @@ class MazeBatchEnv(batch.BatchEnv):
         # Packed 0xAABBGGRR per pixel: bytes R, G, B, A in memory.
         packed = self._rgb_packed.view(torch.uint8).view(self.num_envs, task.height, task.width, 4)
         self._obs.copy_(packed[..., [2, 1, 0]])
-        # What Doom draws over the scene, as on the CPU (mjmaze.look).
+        # Doom's light and what Doom draws over the scene, as on the CPU (mjmaze.look).
+        if self._light is not None:
+            self._obs.copy_(self._light(self._obs, self._depth, self._cam_xpos[:, self._camera], self._qpos[:, 2]))
         if task.draws_pistol:
             still = torch.zeros(self.num_envs, dtype=torch.long, device=self.device)
             dx = torch.round(pistol_dx * task.width).long() if task.head_bob else still

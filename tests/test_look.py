@@ -45,12 +45,49 @@ def wall_grey(env, distance):
 
 def test_walls_are_as_dim_as_vizdooms_and_brighter_near_the_eye():
     env = empty_room(palette.STONE_ROOM)
-    # ViZDoom, a STONE2 wall at sector light 160: 49, 38, 34, 30 grey at 0.5, 1, 2, 4 m.
+    # ViZDoom, a STONE2 wall running north-south at sector light 160: 49, 38, 34, 30 grey at 0.5, 1, 2, 4 m.
     greys = [wall_grey(env, d) for d in (0.5, 1.0, 2.0, 4.0)]
     for got, doom in zip(greys, (49, 38, 34, 30)):
         assert got == pytest.approx(doom, abs=CLOSE)
     assert greys[0] > greys[1] > greys[3]  # the depth cue: light diminishing
     env.task.close()
+
+
+def test_walls_running_east_west_are_as_much_darker_as_vizdooms():
+    # Doom gives walls running east-west 16 light levels less than walls running
+    # north-south (WallHorizLight / WallVertLight). ViZDoom, facing the room's north
+    # (east-west) wall from 1, 2, 4 m: 27, 20, 17 grey; the east (north-south) one: 38, 34, 30.
+    env = empty_room(palette.STONE_ROOM)
+    face = env.task.config.size * env.task.config.cell_size / 2 - walls.WALL_THICKNESS / 2
+    for distance, doom in ((1.0, 26.7), (2.0, 20.4), (4.0, 16.5)):
+        grey = frame_at(env, 0.0, face - distance, np.pi / 2)[24:32, 50:62].mean()
+        assert grey == pytest.approx(doom, abs=3), distance
+        assert wall_grey(env, distance) - grey > 9  # the north-south wall at the same depth
+    env.task.close()
+
+
+def test_a_wall_seen_along_a_corridor_is_lit_by_its_depth_as_in_vizdoom():
+    # Doom lights a wall's pixel by its depth alone, however obliquely the wall is
+    # seen. 0.5 m beside a wall, looking along it: bands of 14 columns from the
+    # frame's edge (~0.4 m deep) towards its centre (~2 m); ViZDoom's mean grey about
+    # the horizon (python tools/doom_frames.py --light). The nearest band is left
+    # out: ViZDoom draws it brighter than any depth of its head-on walls does.
+    env = empty_room(palette.STONE_ROOM)
+    face = env.task.config.size * env.task.config.cell_size / 2 - walls.WALL_THICKNESS / 2
+    along_north = frame_at(env, -2.0, face - 0.5, 0.0)[26:34]  # the east-west wall on the left
+    along_east = frame_at(env, face - 0.5, -2.0, np.pi / 2)[26:34]  # the north-south wall on the right
+    env.task.close()
+    for frame, columns, doom in ((along_north, (14, 28, 42), (41.2, 27.2, 21.8)),
+                                 (along_east, (84, 70, 56), (51.5, 40.6, 28.5))):
+        for start, grey in zip(columns, doom):
+            assert frame[:, start:start + 14].mean() == pytest.approx(grey, abs=4), (start, grey)
+
+
+def test_dooms_light_never_takes_a_colour_past_white():
+    # GL draws every surface by ambient light alone, at most 255 x AMBIENT; Doom's
+    # light multiplies that without clipping (mjmaze.look.DoomLight): a gain above
+    # 1 / AMBIENT would wrap a bright pixel round to black.
+    assert look.light_table().max() * 255 * palette.AMBIENT < 255.5
 
 
 @pytest.mark.parametrize("distance, doom_rows", [(2.0, 25.6), (3.0, 17.1), (4.0, 12.8)])

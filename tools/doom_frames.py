@@ -6,6 +6,7 @@
     python tools/doom_frames.py --contrast   # how much Two-colour's items stand out, 1-4 m ahead
     python tools/doom_frames.py --armour-parts  # the armours' coloured parts, 1-3 m ahead (Two-colour's items)
     python tools/doom_frames.py --projection    # ViZDoom's focal lengths across and down, beside mjmaze's
+    python tools/doom_frames.py --light         # Doom's light over depth: both walls' sides, floor, ceiling
     python tools/doom_frames.py --two-colour RELEASED_REPO/scenarios/basefiles/two_color_basefile.wad
                                             # the released Two-colour script played: health changes, tics survived
 
@@ -17,7 +18,7 @@ units up, the sector at UDMF's default light (160, none is set), things by the
 released type numbers. ViZDoom draws it with the released settings (320x180,
 the pistol shown, no HUD) and the released env's area resize to 112x64.
 ``--calibrate`` prints ViZDoom's mean colours beside mjmaze's: where
-``mjmaze.palette``'s rooms and lamp and the scenarios' object colours come from
+``mjmaze.palette``'s rooms and the scenarios' object colours come from
 (docs/look.md), and what ``tests/test_look.py`` holds.
 """
 
@@ -34,7 +35,7 @@ import imageio.v3 as iio
 import numpy as np
 
 import mjmaze
-from mjmaze import configs, look, maze, palette
+from mjmaze import configs, look, maze, mjcf, palette, walls
 from mjmaze.tasks import base, find_return, k_item, two_colour
 
 UNITS = 128  # Doom map units per metre (mjmaze's 1 m cell is the generator's 128 units)
@@ -372,6 +373,50 @@ def projection() -> None:
     print(f"mjmaze's ego camera at 320x180: {fx:.1f} px across, {fy:.1f} px down")
 
 
+def light() -> None:
+    """Prints Doom's light over depth in the stone room, ViZDoom | mjmaze: ``mjmaze.palette``'s ``DepthLight`` curves.
+
+    Walls: the frame's centre facing a north-south wall (the room's east
+    side) and an east-west one (its north side) head-on, ``depth`` metres
+    ahead. Floor (red channel) and ceiling: the centre columns' rows facing
+    the far wall, each row's depth from Doom's projection at the eye's
+    height. Last, walls seen along them, 0.5 m to the side: column bands from
+    the frame's edge (depth ~0.4 m) towards its centre (~2 m).
+    """
+    env = empty_arena("stone", pistol=False)
+    config = env.task.config
+    edge = config.size * config.cell_size / 2 * UNITS
+    inner = edge - WALL_PAD  # mjmaze's outer wall face
+    print("walls head-on, depth (m): north-south wall | east-west wall, each Doom | mjmaze (mean grey)")
+    for depth in (0.35, 0.5, 0.75, 1, 1.5, 2, 3, 4, 6, 8):
+        greys = []
+        for spawn in ((inner - depth * UNITS, 0.0, 0), (0.0, inner - depth * UNITS, 90)):
+            doom, _ = doom_view(textmap(config, spawn, [], STONE), weapon=False)
+            ours, _ = mjmaze_view(env, spawn, [])
+            greys.append(f"{doom[WALL_PATCH].mean():5.1f} | {ours[WALL_PATCH].mean():5.1f}")
+        print(f"  {depth:4}: " + "    ".join(greys))
+    spawn = (-inner + 0.5 * UNITS, 0.0, 0)  # the far wall ~9 m ahead
+    doom, _ = doom_view(textmap(config, spawn, [], STONE), weapon=False)
+    ours, _ = mjmaze_view(env, spawn, [])
+    height = SIZE[1]
+    print("floor (red) and ceiling by row, depth (m): Doom | mjmaze")
+    for row in (*range(0, 14, 2), *range(36, height, 3)):
+        tangent = (height / 2 - row - 0.5) / (mjcf.DOOM_FOCAL_DOWN * height)  # up, of the row's ray
+        depth = (walls.WALL_HEIGHT - mjcf.EYE_HEIGHT) / tangent if tangent > 0 else -mjcf.EYE_HEIGHT / tangent
+        channel = 0 if tangent < 0 else slice(None)
+        print(f"  row {row:2d} ({'ceiling' if tangent > 0 else 'floor'}, {depth:5.2f} m): "
+              f"{doom[row, 40:72][..., channel].mean():5.1f} | {ours[row, 40:72][..., channel].mean():5.1f}")
+    print("walls seen along them from 0.5 m, bands of 14 columns from the frame's edge: Doom | mjmaze")
+    for label, spawn, columns in (("east-west wall on the left ", (-2 * UNITS, inner - 64, 0), range(0, 56, 14)),
+                                  ("north-south wall on the right", (inner - 64, -2 * UNITS, 90), range(98, 42, -14))):
+        doom, _ = doom_view(textmap(config, spawn, [], STONE), weapon=False)
+        ours, _ = mjmaze_view(env, spawn, [])
+        band = slice(26, 34)  # rows about the horizon
+        print(f"  {label}: " + "   ".join(f"{doom[band, c:c + 14].mean():4.1f} | {ours[band, c:c + 14].mean():4.1f}"
+                                          for c in columns))
+    env.task.close()
+
+
 def armour_parts() -> None:
     """Prints the colour of the armours' coloured parts, 1 / 2 / 3 m ahead in the empty slime arena.
 
@@ -531,9 +576,12 @@ def main() -> None:
     parser.add_argument("--contrast", action="store_true", help="print how much Two-colour's items stand out")
     parser.add_argument("--armour-parts", action="store_true", help="print the armours' coloured parts, 1-3 m ahead")
     parser.add_argument("--projection", action="store_true", help="print ViZDoom's focal lengths beside mjmaze's")
+    parser.add_argument("--light", action="store_true", help="print Doom's light over depth beside mjmaze's")
     parser.add_argument("--episodes", type=int, default=32, help="episodes for --two-colour")
     args = parser.parse_args()
-    if args.projection:
+    if args.light:
+        light()
+    elif args.projection:
         projection()
     elif args.armour_parts:
         armour_parts()

@@ -15,6 +15,7 @@ import collections
 import functools
 import math
 
+import mujoco
 import numpy as np
 from dm_control.rl import control
 from dm_control.suite import base
@@ -84,7 +85,11 @@ class MazeTask(core.MazeRules, base.Task):
         self._qpos, self._qvel = data.qpos, data.qvel
         self._walls = walls.WallLayout(model, self.layout.grid_size, self.layout.cell_size)
         mjcf.set_ego_projection(model, self.width, self.height)
-        self._renderer = render.EgoRenderer(model, CAMERA, self.width, self.height)
+        textured = self.visual_style == "textured"
+        self._renderer = render.EgoRenderer(model, CAMERA, self.width, self.height, depth=textured)
+        self._light = (look.DoomLight(np, "cpu", self.width, self.height, self.layout.grid_size, self.layout.cell_size)
+                       if textured else None)
+        self._camera_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, CAMERA)
         self._eye = model.cam(CAMERA).pos  # a view into the model: head-bob moves it
         self.horizontal_fov = mjcf.EGO_HORIZONTAL_FOV
         self._config_in_model = None
@@ -168,7 +173,11 @@ class MazeTask(core.MazeRules, base.Task):
     def get_observation(self, physics: MazePhysics) -> collections.OrderedDict:
         self._bind(physics)
         pistol_shift = self._bob_view(physics)
-        frame = self._renderer.render(self._bound_data)
+        data = self._bound_data
+        frame = self._renderer.render(data)
+        if self._light is not None:
+            eye, yaw = data.cam_xpos[self._camera_id], data.qpos[2:3]
+            frame = self._light(frame[None], self._renderer.depth[None], eye[None], yaw)[0]
         if self.draws_pistol:
             look.draw_pistol(np, frame[None], *np.array(pistol_shift)[:, None])
         if self.flashes:

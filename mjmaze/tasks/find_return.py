@@ -17,6 +17,11 @@ Arguments
 Metric
     ``success``: target found and return reached; ``target_found``.
 Version History
+    * v3 (2026-11-26): Doom's light: every pixel lit by its depth along the
+      view axis, walls running east-west darker than walls running
+      north-south, floor and ceiling by their own curves, all measured in
+      ViZDoom (``tools/doom_frames.py --light``); before, a lamp at the eye
+      lit surfaces by its angle and distance (docs/look.md, "Light").
     * v2 (2026-11-26): Doom's projection: pixels 1.2x as tall as wide (a
       vertical focal length 1.2x the horizontal, as ViZDoom draws the released
       frames), so walls and things stand 1.2x as tall in the frame as in the
@@ -101,7 +106,7 @@ class FindReturn(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="find_return",
     task=FindReturn,
-    gym_id="mjmaze/FindReturn-v2",
+    gym_id="mjmaze/FindReturn-v3",
     seed_code=2,
     difficulty="size",
     difficulties=SIZES,

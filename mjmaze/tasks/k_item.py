@@ -22,6 +22,11 @@ The collection order is item kind 1, then 2, ... by the released files' colour
 codes: green, red, blue, cyan, magenta, yellow, then two greys, which also
 differ in shape (:data:`KINDS`).
 Version History
+    * v3 (2026-11-26): Doom's light: every pixel lit by its depth along the
+      view axis, walls running east-west darker than walls running
+      north-south, floor and ceiling by their own curves, all measured in
+      ViZDoom (``tools/doom_frames.py --light``); before, a lamp at the eye
+      lit surfaces by its angle and distance (docs/look.md, "Light").
     * v2 (2026-11-26): Doom's projection: pixels 1.2x as tall as wide (a
       vertical focal length 1.2x the horizontal, as ViZDoom draws the released
       frames), so walls and things stand 1.2x as tall in the frame as in the
@@ -129,7 +134,7 @@ class KItem(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="k_item",
     task=KItem,
-    gym_id="mjmaze/KItem-v2",
+    gym_id="mjmaze/KItem-v3",
     seed_code=3,
     difficulty="num_items",
     difficulties=NUM_ITEMS,

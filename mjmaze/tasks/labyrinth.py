@@ -16,6 +16,11 @@ Arguments
 Metric
     ``success``: whether the exit was reached (success rate = mean over episodes).
 Version History
+    * v4 (2026-11-26): Doom's light: every pixel lit by its depth along the
+      view axis, walls running east-west darker than walls running
+      north-south, floor and ceiling by their own curves, all measured in
+      ViZDoom (``tools/doom_frames.py --light``); before, a lamp at the eye
+      lit surfaces by its angle and distance (docs/look.md, "Light").
     * v3 (2026-11-26): Doom's projection: pixels 1.2x as tall as wide (a
       vertical focal length 1.2x the horizontal, as ViZDoom draws the released
       frames), so walls and things stand 1.2x as tall in the frame as in the
@@ -88,7 +93,7 @@ class Labyrinth(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="labyrinth",
     task=Labyrinth,
-    gym_id="mjmaze/Labyrinth-v3",
+    gym_id="mjmaze/Labyrinth-v4",
     seed_code=1,
     difficulty="size",
     difficulties=SIZES,
