@@ -28,10 +28,11 @@ VISUAL_STYLES = ("textured", "flat")
 
 
 BAND_TEXELS = 100  # texture rows for an object's bands (their shares are in hundredths)
-#: Side of the floor's quads: lighting is computed at their
-#: corners. With 1 m quads the floor under the eye flashed 2.5x brighter each
-#: time the agent passed a corner; 0.5 m keeps it within ~15% and costs ~30 us
-#: (~10%) of a frame on llvmpipe (0.25 m: twice that again).
+#: Side of the floor's quads. Chosen when a lamp lit the floor at their
+#: corners (with 1 m quads the floor under the eye flashed 2.5x brighter each
+#: time the agent passed a corner; 0.5 m cost ~30 us of a frame on llvmpipe).
+#: Since Doom's light (mjmaze.look) GL lights evenly, so larger quads should
+#: draw the same frame sooner: not measured or changed yet.
 LIT_QUAD = 0.5
 MAP_UNIT = 1 / 128  # metres per Doom map unit (a 128-unit cell is 1 m)
 EGO_CAMERA = "ego"  # the agent's eye (xml_templates/arena.xml)

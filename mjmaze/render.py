@@ -193,8 +193,8 @@ class EgoRenderer:
                  depth: bool = False):
         """``depth``: also read each frame's depth (:attr:`depth`, metres along the view axis).
         ``map_view``: for top-down maps, light the scene evenly from straight
-        above instead of with the model's lights (the textured style's lamp sits
-        at the agent's eye and fades with distance), and draw no textures, so
+        above instead of with the model's lights (the textured style's ambient
+        light leaves its colours dim until Doom's light), and draw no textures, so
         the floor is one colour under drawn paths. What Doom draws over the
         scene (pistol, flashes) is :mod:`mjmaze.look`'s."""
         gl_context()
