@@ -126,6 +126,8 @@ NORTH_SOUTH_WALL, EAST_WEST_WALL, FLOOR, CEILING, THING = range(5)
 _LIGHT_BINS = 1024  # table rows over inverse depth, 0 .. 1 / _NEAREST
 _NEAREST = 0.1  # metres; nearer pixels take this depth's gain
 _ON_PLANE = 0.02  # metres from a wall face, the floor or the ceiling that still count as on it
+# A pixel's code, the sum of what holds for it; _surface_of_code reads it.
+_EAST_WEST, _OFF_WALLS, _ON_FLOOR, _ON_CEILING = 1, 2, 4, 8
 
 
 def light_table() -> np.ndarray:
@@ -140,14 +142,14 @@ def light_table() -> np.ndarray:
 
 
 def _surface_of_code(code: int) -> int:
-    """The surface of a pixel coded ``east_west + 2 thing + 4 floor + 8 ceiling`` (floor and ceiling first)."""
-    if code & 4:
+    """The surface of a pixel whose code is ``code`` (floor and ceiling first, then things, then walls)."""
+    if code & _ON_FLOOR:
         return FLOOR
-    if code & 8:
+    if code & _ON_CEILING:
         return CEILING
-    if code & 2:
+    if code & _OFF_WALLS:
         return THING
-    return EAST_WEST_WALL if code & 1 else NORTH_SOUTH_WALL
+    return EAST_WEST_WALL if code & _EAST_WEST else NORTH_SOUTH_WALL
 
 
 class DoomLight:
@@ -190,11 +192,12 @@ class DoomLight:
         x = eye[..., 0] / self._cell + self._half_grid + depth * ((cos + right * sin) / self._cell)
         y = eye[..., 1] / self._cell + self._half_grid + depth * ((sin - right * cos) / self._cell)
         off_x, off_y = self._off_wall_face(x), self._off_wall_face(y)
-        code = xp.astype(off_y < off_x, xp.int32) + 2 * xp.astype(xp.minimum(off_x, off_y) > self._on_face, xp.int32)
+        code = (_EAST_WEST * xp.astype(off_y < off_x, xp.int32)
+                + _OFF_WALLS * xp.astype(xp.minimum(off_x, off_y) > self._on_face, xp.int32))
         # The floor and the ceiling: pixels as deep as their row's ray meets the plane.
         up = self._up[:, None]
         plane = xp.where(up < 0, (eye[..., 2] - _ON_PLANE) / -up, (walls.WALL_HEIGHT - _ON_PLANE - eye[..., 2]) / up)
-        code = xp.where(depth > plane, xp.where(up < 0, 4, 8), code)
+        code = xp.where(depth > plane, xp.where(up < 0, _ON_FLOOR, _ON_CEILING), code)
         bins = xp.astype(rules.at_most(xp, (_LIGHT_BINS * _NEAREST) / depth, _LIGHT_BINS - 1), xp.int32)
         gain = xp.take(self._gains, xp.reshape(code * _LIGHT_BINS + bins, (-1,)), axis=0)
         return xp.astype(xp.astype(frames, xp.float32) * xp.reshape(gain, frames.shape) + 0.5, xp.uint8)

@@ -71,7 +71,7 @@ GREEN_ARMOUR_BANDS = (
 )
 #: The light GL draws every surface with: ambient only, no lamp. Doom's light
 #: (below) is applied to the frame afterwards, per pixel, by its depth
-#: (:func:`mjmaze.look.doom_light`); mjmaze's surfaces drawn so show
+#: (:class:`mjmaze.look.DoomLight`); mjmaze's surfaces drawn so show
 #: ``255 x colour x AMBIENT`` grey levels before it.
 AMBIENT = 0.28
 
