@@ -133,12 +133,9 @@ _EAST_WEST, _OFF_WALLS, _ON_FLOOR, _ON_CEILING = 1, 2, 4, 8
 def light_table() -> np.ndarray:
     """``(5, bins)`` float32: each surface's gain (:data:`NORTH_SOUTH_WALL` ...) over inverse depth."""
     depth = 1 / ((np.arange(_LIGHT_BINS) + 0.5) / (_LIGHT_BINS * _NEAREST))
-    # Things: the lamp, head-on (palette.THING_LAMP); nearer than ~0.36 m it
-    # saturated as GL's light does, at 1 (which also keeps every lit colour
-    # within 255: GL draws none above 255 x AMBIENT before Doom's light).
-    thing = np.minimum(1 + palette.THING_LAMP / (0.05 + depth) / palette.AMBIENT, 1 / palette.AMBIENT)
-    light = palette.NORTH_SOUTH_WALL_LIGHT, palette.EAST_WEST_WALL_LIGHT, palette.FLOOR_LIGHT, palette.CEILING_LIGHT
-    return np.stack([surface.gain(depth) for surface in light] + [thing]).astype(np.float32)
+    light = (palette.NORTH_SOUTH_WALL_LIGHT, palette.EAST_WEST_WALL_LIGHT, palette.FLOOR_LIGHT,
+             palette.CEILING_LIGHT, palette.THING_LIGHT)  # in the order of NORTH_SOUTH_WALL ... THING
+    return np.stack([surface.gain(depth) for surface in light]).astype(np.float32)
 
 
 def _surface_of_code(code: int) -> int:

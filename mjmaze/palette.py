@@ -116,11 +116,17 @@ FLOOR_LIGHT = DepthLight(
 CEILING_LIGHT = DepthLight(
     (1.1, 1.37, 1.56, 1.8, 2.16, 2.58, 3.36, 4.68, 9.6),
     (34, 32, 30, 28.5, 28, 26, 24.5, 23, 22.5), 255 * STONE_ROOM.ceiling[0])
-#: Things (exits, items, pillars, totems): their colours above were measured
-#: beside ViZDoom's with mjmaze's earlier light, a lamp at the eye that added
-#: ``THING_LAMP / (0.05 + d)`` to the ambient light on a surface facing it
-#: ``d`` metres away; they keep that light, seen head-on, at their depth.
-THING_LAMP = 0.30
+#: Things (exits, items, pillars, totems): Doom lights a sprite by its
+#: sector's level over depth without the walls' +-8 (ZDoom's fake contrast),
+#: so between the two walls' curves: ViZDoom's tall columns (which do not
+#: blink, as the armours do) are 1.32x as bright 1 m ahead as 2 m ahead, and
+#: as bright 3 m ahead (``python tools/doom_frames.py --calibrate``); the
+#: walls' mean gives 1.25x and 0.95x. ``unlit`` makes the columns, drawn in
+#: their colours above, ViZDoom's over 1-3 m (mjmaze's earlier lamp drew
+#: things ~7% brighter there, and its light fell 1.36x from 2 m to 1 m).
+_THING_GREY = tuple((north_south + east_west) / 2
+                    for north_south, east_west in zip(NORTH_SOUTH_WALL_LIGHT.grey, EAST_WEST_WALL_LIGHT.grey))
+THING_LIGHT = DepthLight(_WALL_DEPTHS, _THING_GREY, 19.0)
 TEXTURE_TEXELS = 64  # per side of a texture; one texture covers 1 m x 1 m
 # 1 / the mean grey of each texture (see _brick_texels, _tile_texels).
 TEXTURE_GAIN = {"wall": 1.35, "floor": 1.6}

@@ -17,6 +17,10 @@ Arguments
 Metric
     ``success``: target found and return reached; ``target_found``.
 Version History
+    * v4 (2026-11-26): things (exits, items, pillars, totems) lit as Doom
+      lights sprites: by the sector's light over depth, between the two
+      walls' curves (``palette.THING_LIGHT``); before, the old lamp's curve,
+      too bright within ~1.5 m and too dark beyond 2 m (docs/look.md, "Light").
     * v3 (2026-11-26): Doom's light: every pixel lit by its depth along the
       view axis, walls running east-west darker than walls running
       north-south, floor and ceiling by their own curves, all measured in
@@ -106,7 +110,7 @@ class FindReturn(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="find_return",
     task=FindReturn,
-    gym_id="mjmaze/FindReturn-v3",
+    gym_id="mjmaze/FindReturn-v4",
     seed_code=2,
     difficulty="size",
     difficulties=SIZES,

@@ -22,6 +22,10 @@ The collection order is item kind 1, then 2, ... by the released files' colour
 codes: green, red, blue, cyan, magenta, yellow, then two greys, which also
 differ in shape (:data:`KINDS`).
 Version History
+    * v4 (2026-11-26): things (exits, items, pillars, totems) lit as Doom
+      lights sprites: by the sector's light over depth, between the two
+      walls' curves (``palette.THING_LIGHT``); before, the old lamp's curve,
+      too bright within ~1.5 m and too dark beyond 2 m (docs/look.md, "Light").
     * v3 (2026-11-26): Doom's light: every pixel lit by its depth along the
       view axis, walls running east-west darker than walls running
       north-south, floor and ceiling by their own curves, all measured in
@@ -134,7 +138,7 @@ class KItem(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="k_item",
     task=KItem,
-    gym_id="mjmaze/KItem-v3",
+    gym_id="mjmaze/KItem-v4",
     seed_code=3,
     difficulty="num_items",
     difficulties=NUM_ITEMS,

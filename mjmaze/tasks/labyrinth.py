@@ -16,6 +16,10 @@ Arguments
 Metric
     ``success``: whether the exit was reached (success rate = mean over episodes).
 Version History
+    * v5 (2026-11-26): things (exits, items, pillars, totems) lit as Doom
+      lights sprites: by the sector's light over depth, between the two
+      walls' curves (``palette.THING_LIGHT``); before, the old lamp's curve,
+      too bright within ~1.5 m and too dark beyond 2 m (docs/look.md, "Light").
     * v4 (2026-11-26): Doom's light: every pixel lit by its depth along the
       view axis, walls running east-west darker than walls running
       north-south, floor and ceiling by their own curves, all measured in
@@ -93,7 +97,7 @@ class Labyrinth(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="labyrinth",
     task=Labyrinth,
-    gym_id="mjmaze/Labyrinth-v4",
+    gym_id="mjmaze/Labyrinth-v5",
     seed_code=1,
     difficulty="size",
     difficulties=SIZES,

@@ -36,6 +36,10 @@ Arguments
 Metric
     ``duration``: tics survived (max 2100); also ``health`` and ``totem_green``.
 Version History
+    * v5 (2026-11-26): things (exits, items, pillars, totems) lit as Doom
+      lights sprites: by the sector's light over depth, between the two
+      walls' curves (``palette.THING_LIGHT``); before, the old lamp's curve,
+      too bright within ~1.5 m and too dark beyond 2 m (docs/look.md, "Light").
     * v4 (2026-11-26): Doom's light: every pixel lit by its depth along the
       view axis, walls running east-west darker than walls running
       north-south, floor and ceiling by their own curves, all measured in
@@ -331,7 +335,7 @@ class TwoColour(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="two_colour",
     task=TwoColour,
-    gym_id="mjmaze/TwoColour-v4",
+    gym_id="mjmaze/TwoColour-v5",
     seed_code=4,
     difficulty="complexity",
     difficulties=COMPLEXITIES,
