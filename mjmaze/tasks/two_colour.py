@@ -39,7 +39,7 @@ Version History
     * v5 (2026-11-26): things (exits, items, pillars, totems) lit as Doom
       lights sprites: by the sector's light over depth, between the two
       walls' curves (``palette.THING_LIGHT``); before, the old lamp's curve,
-      too bright within ~1.5 m and too dark beyond 2 m (docs/look.md, "Light").
+      8-22% brighter within 2 m, as bright beyond 3 m (docs/look.md, "Light").
     * v4 (2026-11-26): Doom's light: every pixel lit by its depth along the
       view axis, walls running east-west darker than walls running
       north-south, floor and ceiling by their own curves, all measured in
