@@ -133,9 +133,9 @@ _EAST_WEST, _OFF_WALLS, _ON_FLOOR, _ON_CEILING = 1, 2, 4, 8
 def light_table() -> np.ndarray:
     """``(5, bins)`` float32: each surface's gain (:data:`NORTH_SOUTH_WALL` ...) over inverse depth."""
     depth = 1 / ((np.arange(_LIGHT_BINS) + 0.5) / (_LIGHT_BINS * _NEAREST))
-    light = (palette.NORTH_SOUTH_WALL_LIGHT, palette.EAST_WEST_WALL_LIGHT, palette.FLOOR_LIGHT,
-             palette.CEILING_LIGHT, palette.THING_LIGHT)  # in the order of NORTH_SOUTH_WALL ... THING
-    return np.stack([surface.gain(depth) for surface in light]).astype(np.float32)
+    light = {NORTH_SOUTH_WALL: palette.NORTH_SOUTH_WALL_LIGHT, EAST_WEST_WALL: palette.EAST_WEST_WALL_LIGHT,
+             FLOOR: palette.FLOOR_LIGHT, CEILING: palette.CEILING_LIGHT, THING: palette.THING_LIGHT}
+    return np.stack([light[surface].gain(depth) for surface in range(len(light))]).astype(np.float32)
 
 
 def _surface_of_code(code: int) -> int:

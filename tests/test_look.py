@@ -184,13 +184,13 @@ def test_the_exit_on_a_map_and_in_the_flat_style_is_its_mean_colour():
     (two_colour.ITEMS[0].name, two_colour.ITEM_GREEN, (37, 78, 28)),
 ])
 def test_two_colour_objects_2m_ahead_have_vizdooms_colours(name, rgba, doom):
-    assert objects_ahead(name, rgba) == pytest.approx(doom, abs=CLOSE)
+    assert object_ahead(name, rgba) == pytest.approx(doom, abs=CLOSE)
 
 
 def test_two_colour_red_items_are_the_red_armours_body_as_red_as_gl_draws():
     # ViZDoom draws the body at (121, 11, 11) (1-3 m ahead): mjmaze's red channel is at its limit.
     assert two_colour.ITEM_RED[0] == 1.0
-    red, green, blue = objects_ahead(two_colour.ITEMS[1].name, two_colour.ITEM_RED)
+    red, green, blue = object_ahead(two_colour.ITEMS[1].name, two_colour.ITEM_RED)
     assert (green, blue) == pytest.approx((11, 11), abs=CLOSE) and red > 80
 
 
@@ -210,12 +210,12 @@ def test_things_fade_with_depth_as_dooms_columns_do():
     # 2 m ahead, and 3 m ahead as bright (0.99x, within what its few pixels tell).
     # mjmaze's earlier lamp gave 1.36x and 0.86x.
     for rgba, channel in ((two_colour.RED, 0), (two_colour.GREEN, 1)):
-        near, middle, far = (objects_ahead(two_colour.TOTEM.name, rgba, d)[channel] for d in (1.0, 2.0, 3.0))
+        near, middle, far = (object_ahead(two_colour.TOTEM.name, rgba, d)[channel] for d in (1.0, 2.0, 3.0))
         assert near / middle == pytest.approx(1.31, abs=0.04)
         assert 0.87 < far / middle < 1.0
 
 
-def objects_ahead(name, rgba, distance=2.0):
+def object_ahead(name, rgba, distance=2.0):
     """Mean colour of object ``name`` in colour ``rgba``, ``distance`` m ahead in the empty slime room."""
     env = empty_room(palette.SLIME_ROOM)
     physics = env.physics
