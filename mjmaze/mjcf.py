@@ -63,6 +63,10 @@ class ObjectGeom:
     so that their mean is ``rgba`` (the calibrated mean colour, which maps and
     the flat style show). Bands vary only with height: a cylinder shows the same
     side from every direction, as a sprite, where a left-right pattern would turn.
+
+    ``glow``: the object's material emission. GL draws it ``rgba x (AMBIENT +
+    glow)`` before Doom's light, so a thing brighter than the ambient light can
+    draw (Doom's fullbright frames) keeps its hue: ``rgba`` is scaled down to match.
     """
 
     name: str
@@ -72,6 +76,7 @@ class ObjectGeom:
     z: float
     collides: bool = False
     bands: tuple[tuple[float, tuple[float, float, float]], ...] = ()
+    glow: float = 0.0
 
     def band_texels(self) -> tuple[np.ndarray, float]:
         """``(texels (BAND_TEXELS, 1, 3) uint8, gain)``: the bands as texture rows
@@ -88,16 +93,18 @@ class ObjectGeom:
         return texels[:, None, :], gain
 
 
-def floor_thing(name: str, shape: str, width: float, height: float, rgba, collides: bool = False) -> ObjectGeom:
+def floor_thing(name: str, shape: str, width: float, height: float, rgba, collides: bool = False,
+                glow: float = 0.0) -> ObjectGeom:
     """A Doom thing on the floor, ``width`` x ``height`` map units (its sprite's size), as an object geom.
 
     A sprite always faces the camera; a cylinder (``shape="cylinder"``, or a
     ``"sphere"`` of diameter ``width``) shows the same width from every side.
+    ``glow``: see :class:`ObjectGeom`.
     """
     radius, height = width / 2 * MAP_UNIT, height * MAP_UNIT
     if shape == "sphere":
-        return ObjectGeom(name, "sphere", (radius,), rgba, radius, collides)
-    return ObjectGeom(name, "cylinder", (radius, height / 2), rgba, height / 2, collides)
+        return ObjectGeom(name, "sphere", (radius,), rgba, radius, collides, glow=glow)
+    return ObjectGeom(name, "cylinder", (radius, height / 2), rgba, height / 2, collides, glow=glow)
 
 
 def template_path(name: str = "arena.xml"):
@@ -198,9 +205,17 @@ def build_xml(
             texels, gain = obj.band_texels()
             ET.SubElement(asset, "texture", name=obj.name, type="2d", builtin="flat",
                           width=str(texels.shape[1]), height=str(texels.shape[0]), rgb1="1 1 1")
-            ET.SubElement(asset, "material", name=obj.name, texture=obj.name, specular="0", shininess="0", reflectance="0")
+            ET.SubElement(asset, "material", name=obj.name, texture=obj.name, emission=str(obj.glow),
+                          specular="0", shininess="0", reflectance="0")
             attrs["material"] = obj.name
             rgba = (*np.minimum(np.array(obj.rgba[:3]) * gain, 1.0).round(4).tolist(), obj.rgba[3])
+        elif obj.glow:
+            # One material per glow (Two-colour's 90 items share one).
+            material = f"glow_{obj.glow}"
+            if asset.find(f"material[@name='{material}']") is None:
+                ET.SubElement(asset, "material", name=material, emission=str(obj.glow),
+                              specular="0", shininess="0", reflectance="0")
+            attrs["material"] = material
         attrs["rgba"] = " ".join(map(str, rgba))
         if batch and obj.collides:
             colliding.append((obj, attrs))

@@ -50,14 +50,19 @@ RED_ARMOUR_RGBA = (0.73, 0.31, 0.30, 1.0)
 #: cannot show a sprite's two parts, and the mean above mixes in the grey
 #: plates both armours share, so green and red items looked more alike than
 #: ViZDoom's and the released agent picked 30-50% fewer (docs/paper_agents.md).
-#: ViZDoom draws the green armour's green chest at (43, 90, 33), (31, 66, 23),
-#: (36, 77, 28) and the red armour's body at (122, 12, 12), (119, 9, 9),
-#: (123, 11, 11), 1 / 2 / 3 m ahead in the slime room
-#: (``python tools/doom_frames.py --armour-parts``); these give their mean
-#: 2 m ahead in mjmaze. The red one at the renderer's limit (ViZDoom's is
-#: ~35% brighter than a red channel of 1 can draw).
-GREEN_ARMOUR_PART_RGBA = (0.42, 0.85, 0.30, 1.0)
-RED_ARMOUR_PART_RGBA = (1.0, 0.12, 0.12, 1.0)
+#: The armours blink: Doom draws picture A lit by the sector for 6 tics, then
+#: the fullbright picture B for 7, which does not fade with depth. ViZDoom
+#: draws the green chest at (20, 41, 13) / (46, 98, 36) (A / B) 2 m ahead and
+#: (23, 48, 15) / (50, 107, 40) 3 m ahead, the red body at (86, 5, 4) /
+#: (139, 11, 11) and (83, 3, 3) / (144, 15, 15) (``python tools/doom_frames.py
+#: --armour-parts``, the slime room). The items show the blink's average, 2
+#: and 3 m ahead, under Doom's light: (36, 76, 27) and (115, 9, 9), each
+#: ``255 x colour x (AMBIENT + ARMOUR_PART_GLOW) x THING_LIGHT`` at 2.5 m. The
+#: red body is brighter than GL's ambient light alone can draw: the items glow
+#: (:attr:`mjmaze.mjcf.ObjectGeom.glow`).
+GREEN_ARMOUR_PART_RGBA = (0.184, 0.389, 0.138, 1.0)
+RED_ARMOUR_PART_RGBA = (0.588, 0.046, 0.046, 1.0)
+ARMOUR_PART_GLOW = 0.28
 #: The green armour's sprite (Freedoom's ARM1, 542 pixels) read from top to
 #: bottom as ``(share of its pixels, their mean colour)``: the grey shoulder
 #: plates, the green chest, the dark lower edge. ViZDoom's frames of the

@@ -53,7 +53,7 @@ PAPER_TABLE = (
     [("mjmaze/Labyrinth-v5", {"size": n}) for n in labyrinth.SIZES]
     + [("mjmaze/FindReturn-v4", {"size": n}) for n in find_return.SIZES]
     + [("mjmaze/KItem-v4", {"num_items": k}) for k in k_item.PAPER_NUM_ITEMS]
-    + [("mjmaze/TwoColour-v5", {"complexity": c}) for c in two_colour.PAPER_COMPLEXITIES]
+    + [("mjmaze/TwoColour-v6", {"complexity": c}) for c in two_colour.PAPER_COMPLEXITIES]
 )
 
 
@@ -119,13 +119,14 @@ def test_an_old_id_names_the_current_one():
     # -v2 (-v1 for Find-and-return and K-item) drew Doom's pixels square (docs/look.md, "Projection");
     # -v3 (-v2) lit by a lamp's angle and distance where Doom lights by depth and a wall's side.
     # -v4 (-v3) lit things by the lamp's curve where Doom lights sprites by the sector's.
+    # TwoColour-v5 drew its items' colours calibrated under an earlier light, not the armours' blink.
     for old, current in (("Labyrinth-v0", "Labyrinth-v5"), ("Labyrinth-v4", "Labyrinth-v5"),
-                         ("TwoColour-v0", "TwoColour-v5"), ("TwoColour-v4", "TwoColour-v5"),
+                         ("TwoColour-v0", "TwoColour-v6"), ("TwoColour-v5", "TwoColour-v6"),
                          ("FindReturn-v3", "FindReturn-v4"), ("KItem-v3", "KItem-v4")):
         with pytest.raises(gymnasium.error.DeprecatedEnv, match=f"mjmaze/{current}"):
             gymnasium.make(f"mjmaze/{old}")
     assert {mjmaze.registry.get(name).gym_id for name in mjmaze.ALL_TASKS} == {
-        "mjmaze/Labyrinth-v5", "mjmaze/FindReturn-v4", "mjmaze/KItem-v4", "mjmaze/TwoColour-v5"}
+        "mjmaze/Labyrinth-v5", "mjmaze/FindReturn-v4", "mjmaze/KItem-v4", "mjmaze/TwoColour-v6"}
 
 
 def test_bad_input_through_gymnasium():
@@ -158,7 +159,7 @@ def test_the_cpu_envs_import_neither_warp_nor_torch():
 
     code = (
         "import sys, gymnasium, mjmaze\n"
-        "env = gymnasium.make('mjmaze/TwoColour-v5'); env.reset(seed=0); env.step(0)\n"
+        "env = gymnasium.make('mjmaze/TwoColour-v6'); env.reset(seed=0); env.step(0)\n"
         "print(sorted(m for m in ('warp', 'mujoco_warp', 'torch') if m in sys.modules))\n"
     )
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)

@@ -180,24 +180,33 @@ def test_the_exit_on_a_map_and_in_the_flat_style_is_its_mean_colour():
 @pytest.mark.parametrize("name, rgba, doom", [
     (two_colour.TOTEM.name, two_colour.GREEN, (24, 48, 17)),  # tall green column
     (two_colour.TOTEM.name, two_colour.RED, (69, 6, 4)),  # tall red column
-    # The green armour's green chest, its mean 1-3 m ahead (tools/doom_frames.py --armour-parts).
-    (two_colour.ITEMS[0].name, two_colour.ITEM_GREEN, (37, 78, 28)),
+    # The armours' coloured parts averaged over their blink (6 tics lit by the
+    # sector, 7 fullbright; tools/doom_frames.py --armour-parts): the green chest,
+    # the red body, which is brighter than GL's ambient light alone draws (the items glow).
+    (two_colour.ITEMS[0].name, two_colour.ITEM_GREEN, (34, 72, 25)),
+    (two_colour.ITEMS[1].name, two_colour.ITEM_RED, (115, 8, 8)),
 ])
 def test_two_colour_objects_2m_ahead_have_vizdooms_colours(name, rgba, doom):
     assert object_ahead(name, rgba) == pytest.approx(doom, abs=CLOSE)
 
 
-def test_two_colour_red_items_are_the_red_armours_body_as_red_as_gl_draws():
-    # ViZDoom draws the body at (121, 11, 11) (1-3 m ahead): mjmaze's red channel is at its limit.
-    assert two_colour.ITEM_RED[0] == 1.0
-    red, green, blue = object_ahead(two_colour.ITEMS[1].name, two_colour.ITEM_RED)
-    assert (green, blue) == pytest.approx((11, 11), abs=CLOSE) and red > 80
+@pytest.mark.parametrize("scenario", mjmaze.ALL_TASKS)
+def test_no_object_is_drawn_brighter_than_a_frame_can_hold(scenario):
+    # Doom's light multiplies GL's 8-bit colours (look.DoomLight) and does not
+    # clip: a glowing object's brightest channel at the nearest light must stay
+    # within 255, or it would wrap around to a dark colour.
+    nearest_gain = float(look.light_table()[look.THING].max())
+    for obj in mjmaze.registry.get(scenario).task.objects:
+        colours = [obj.rgba] + ([two_colour.ITEM_GREEN, two_colour.ITEM_RED] if scenario == "two_colour" else [])
+        brightest = max(max(colour[:3]) for colour in colours) * (palette.AMBIENT + obj.glow) * 255 * nearest_gain
+        assert brightest < 255, obj.name
 
 
 def test_two_colour_items_differ_more_than_the_whole_sprites_means():
     # The sprites' means share the grey plates: the parts are what tell the two colours apart.
-    parts = np.subtract(two_colour.ITEM_GREEN[:3], two_colour.ITEM_RED[:3])
-    means = np.subtract(palette.GREEN_ARMOUR_RGBA[:3], palette.RED_ARMOUR_RGBA[:3])
+    # (As GL draws them: the items glow, the means do not.)
+    parts = np.subtract(two_colour.ITEM_GREEN[:3], two_colour.ITEM_RED[:3]) * (palette.AMBIENT + two_colour.ITEMS[0].glow)
+    means = np.subtract(palette.GREEN_ARMOUR_RGBA[:3], palette.RED_ARMOUR_RGBA[:3]) * palette.AMBIENT
     assert np.linalg.norm(parts) > 2 * np.linalg.norm(means)
 
 
@@ -236,8 +245,9 @@ def test_k_items_first_two_kinds_are_the_released_armours_as_vizdoom_draws_them(
     assert (green.rgba, red.rgba) == (palette.GREEN_ARMOUR_RGBA, palette.RED_ARMOUR_RGBA)
     env = empty_room(palette.STONE_ROOM)  # K-item's room
     physics = env.physics
-    ids = physics.object_ids([two_colour.ITEMS[0].name])
-    physics.set_object_rgba(ids[1][0], green.rgba)
+    stand_in = two_colour.ITEMS[0]  # a floor cylinder of the armour's size, which glows: dimmed to draw as K-item's
+    ids = physics.object_ids([stand_in.name])
+    physics.set_object_rgba(ids[1][0], (*np.multiply(green.rgba[:3], palette.AMBIENT / (palette.AMBIENT + stand_in.glow)), 1.0))
     physics.show_objects(ids[1], True)
     physics.place_objects(ids[0], np.array([[2.0, 0.0]]))
     # ViZDoom's green armour 2 m ahead in the STONE2 room (the Labyrinth exit's measurement): (49, 59, 37).

@@ -36,6 +36,9 @@ Arguments
 Metric
     ``duration``: tics survived (max 2100); also ``health`` and ``totem_green``.
 Version History
+    * v6 (2026-11-26): items in their coloured parts' colours as ViZDoom
+      draws them averaged over the armours' blink, 2-3 m ahead under Doom's
+      light (green 11% darker, red 15-20% brighter; docs/paper_agents.md, item 15).
     * v5 (2026-11-26): things (exits, items, pillars, totems) lit as Doom
       lights sprites: by the sector's light over depth, between the two
       walls' curves (``palette.THING_LIGHT``); before, the old lamp's curve,
@@ -115,7 +118,8 @@ _CHUNK_ELEMENTS = 1 << 24
 # Find-and-return's pillars); the items are Freedoom's green armour and its
 # "blue" armour, which Freedoom draws red (the released ACS calls it the red
 # armour), lying on the floor at their sprites' size, each in the colour of
-# its sprite's coloured part as ViZDoom draws it (see palette.GREEN_ARMOUR_PART_RGBA).
+# its sprite's coloured part as ViZDoom draws it, averaged over the armour's
+# blink (see palette.GREEN_ARMOUR_PART_RGBA).
 RED, GREEN = palette.TALL_RED_COLUMN_RGBA, palette.TALL_GREEN_COLUMN_RGBA
 ITEM_RED, ITEM_GREEN = palette.RED_ARMOUR_PART_RGBA, palette.GREEN_ARMOUR_PART_RGBA
 TOTEM = mjcf.floor_thing("totem", "cylinder", 32, 52, RED, collides=True)
@@ -125,7 +129,8 @@ TOTEM_CLEARANCE = TOTEM_RADIUS + core.AGENT_RADIUS
 # Where the released map keeps the columns until its script moves one in
 # (4,096 map units west of the centre), and an absent totem stays.
 TOTEM_PARKED_XY = (-4096 * mjcf.MAP_UNIT, 0.0)
-ITEMS = tuple(mjcf.floor_thing(f"item_{k}", "cylinder", 31, 17, ITEM_RED) for k in range(POOL_SIZE))
+ITEMS = tuple(mjcf.floor_thing(f"item_{k}", "cylinder", 31, 17, ITEM_RED, glow=palette.ARMOUR_PART_GLOW)
+              for k in range(POOL_SIZE))
 TOTEM_COLOURS = (tuple(RED), tuple(GREEN))  # by totem_green
 ITEM_COLOURS = tuple(tuple(ITEM_GREEN if k % 2 == 0 else ITEM_RED) for k in range(POOL_SIZE))
 
@@ -335,7 +340,7 @@ class TwoColour(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="two_colour",
     task=TwoColour,
-    gym_id="mjmaze/TwoColour-v5",
+    gym_id="mjmaze/TwoColour-v6",
     seed_code=4,
     difficulty="complexity",
     difficulties=COMPLEXITIES,
