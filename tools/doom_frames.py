@@ -4,7 +4,7 @@
     python tools/doom_frames.py --calibrate  # colours of walls, floor, ceiling and objects, both engines
     python tools/doom_frames.py --flashes    # ViZDoom's red (hurt) and gold (pickup) flashes, tic by tic
     python tools/doom_frames.py --contrast   # how much Two-colour's items stand out, 1-4 m ahead
-    python tools/doom_frames.py --armour-parts  # the armours' coloured parts, 1-3 m ahead (Two-colour's items)
+    python tools/doom_frames.py --armour-parts  # the armours' coloured parts over their blink, 1-4 m ahead (Two-colour's items)
     python tools/doom_frames.py --projection    # ViZDoom's focal lengths across and down, beside mjmaze's
     python tools/doom_frames.py --light         # Doom's light over depth: both walls' sides, floor, ceiling
     python tools/doom_frames.py --two-colour RELEASED_REPO/scenarios/basefiles/two_color_basefile.wad
@@ -42,6 +42,7 @@ UNITS = 128  # Doom map units per metre (mjmaze's 1 m cell is the generator's 12
 WALL_PAD = 8  # the generator's half thickness of a wall block
 SIZE = (112, 64)
 ANIMATION_TICS = 13  # Doom's armour sprites: ARM1 A 6 tics, B (bright) 7
+ANIMATION_A_TICS = 6
 RAISE_TICS = 8  # the pistol is still being raised for ~6 tics after the released start (tic 10)
 # Doom textures of the released rooms: (walls, floor, ceiling).
 STONE = ("STONE2", "FLAT1_1", "MFLR8_1")  # Labyrinth, Find-and-return, K-item
@@ -418,27 +419,45 @@ def light() -> None:
 
 
 def armour_parts() -> None:
-    """Prints the colour of the armours' coloured parts, 1 / 2 / 3 m ahead in the empty slime arena.
+    """Prints the colour of the armours' coloured parts, 1 to 4 m ahead in the empty slime arena.
 
-    ViZDoom's frame at the released 320x180, over the blink cycle, the
-    armour's pixels (labels buffer) split by hue: the green armour's green
-    chest, Freedoom's "blue" armour's red body; the rest is their grey
-    plates and edges. Two-colour draws each item in its coloured part's
-    colour (``palette.GREEN_ARMOUR_PART_RGBA``, ``RED_ARMOUR_PART_RGBA``).
+    ViZDoom's frame at the released 320x180, over the blink cycle: Doom draws
+    picture A lit by the sector for 6 tics, then the fullbright picture B for
+    7. Per picture, the armour's pixels (labels buffer) split by hue: the
+    green armour's green chest, Freedoom's "blue" armour's red body; the rest
+    is their grey plates and edges. Two-colour draws each item in its
+    coloured part's colour averaged over the blink (``palette.GREEN_ARMOUR_PART_RGBA``).
     """
-    env = empty_arena("slime")
-    config = env.task.config
-    for label, doom_type, channel, margin in (("green armour, green part", GREEN_ARMOUR, 1, 10),
-                                              ("red armour, red part", BLUE_ARMOUR, 0, 30)):
+    env = empty_arena("slime", pistol=False)
+    config, physics = env.task.config, env.physics
+    name = two_colour.ITEMS[0].name
+    ids = physics.object_ids([name])
+    print("coloured part, d m ahead: ViZDoom's picture A (sector-lit) / B (fullbright) -> the blink's average "
+          "(6 A + 7 B) / 13 | mjmaze's item")
+    for label, doom_type, channel, margin, rgba in (
+            ("green armour, green part", GREEN_ARMOUR, 1, 10, two_colour.ITEM_GREEN),
+            ("red armour, red part", BLUE_ARMOUR, 0, 30, two_colour.ITEM_RED)):
+        physics.set_object_rgba(ids[1][0], rgba)
+        physics.show_objects(ids[1], True)
         results = []
-        for d in (1, 2, 3):
+        for d in (1, 2, 3, 4):
             screens, drawn = doom_tics(textmap(config, (0.0, 0.0, 0), [Thing(d * UNITS, 0.0, doom_type)], SLIME),
                                        weapon=False, resize=False)
-            pixels = screens[drawn].astype(np.float64)
-            others = np.delete(pixels, channel, axis=1).max(axis=1)
-            part = pixels[:, channel] > others + margin
-            results.append(f"{np.round(pixels[part].mean(axis=0)).astype(int).tolist()} ({part.mean():.0%} of its pixels)")
-        print(f"  {label}: " + "   ".join(results))
+            brightness = np.array([screen[mask][:, channel].mean() for screen, mask in zip(screens, drawn)])
+            bright = brightness > brightness.mean()  # picture B
+            parts = []
+            for picture in (~bright, bright):
+                pixels = np.concatenate([screen[mask] for screen, mask, p in zip(screens, drawn, picture) if p])
+                pixels = pixels.astype(np.float64)
+                part = pixels[:, channel] > np.delete(pixels, channel, axis=1).max(axis=1) + margin
+                parts.append(pixels[part].mean(axis=0))
+            average = (ANIMATION_A_TICS * parts[0] + (ANIMATION_TICS - ANIMATION_A_TICS) * parts[1]) / ANIMATION_TICS
+            physics.place_objects(ids[0], np.array([[d, 0.0]]))
+            frame, mask = mjmaze_view(env, (0.0, 0.0, 0), [name])
+            results.append(f"{d} m: " + " / ".join(str(np.round(p).astype(int).tolist()) for p in parts)
+                           + f" -> {np.round(average).astype(int).tolist()} | {mean_colour(frame, mask > 0.99)}")
+        physics.show_objects(ids[1], False)
+        print(f"  {label}:\n    " + "\n    ".join(results))
     env.task.close()
 
 
@@ -574,7 +593,7 @@ def main() -> None:
     parser.add_argument("--two-colour", type=pathlib.Path, metavar="BASEFILE_WAD",
                         help="play the released Two-colour script (two_color_basefile.wad of the released repo)")
     parser.add_argument("--contrast", action="store_true", help="print how much Two-colour's items stand out")
-    parser.add_argument("--armour-parts", action="store_true", help="print the armours' coloured parts, 1-3 m ahead")
+    parser.add_argument("--armour-parts", action="store_true", help="print the armours' coloured parts over their blink, 1-4 m ahead")
     parser.add_argument("--projection", action="store_true", help="print ViZDoom's focal lengths beside mjmaze's")
     parser.add_argument("--light", action="store_true", help="print Doom's light over depth beside mjmaze's")
     parser.add_argument("--episodes", type=int, default=32, help="episodes for --two-colour")
