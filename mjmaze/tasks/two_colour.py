@@ -38,7 +38,7 @@ Metric
 Version History
     * v6 (2026-11-26): items in their coloured parts' colours as ViZDoom
       draws them averaged over the armours' blink, 2-3 m ahead under Doom's
-      light (green 11% darker, red 15-20% brighter; docs/paper_agents.md, item 15).
+      light (green 8% darker, red 18% brighter; docs/paper_agents.md, item 15).
     * v5 (2026-11-26): things (exits, items, pillars, totems) lit as Doom
       lights sprites: by the sector's light over depth, between the two
       walls' curves (``palette.THING_LIGHT``); before, the old lamp's curve,
