@@ -78,6 +78,10 @@ class ObjectGeom:
     bands: tuple[tuple[float, tuple[float, float, float]], ...] = ()
     glow: float = 0.0
 
+    def unlit(self, rgba=None) -> np.ndarray:
+        """The RGB (0-1) GL draws the object in before Doom's light, in ``rgba`` (default: its own)."""
+        return np.asarray(self.rgba if rgba is None else rgba, dtype=float)[:3] * (palette.AMBIENT + self.glow)
+
     def band_texels(self) -> tuple[np.ndarray, float]:
         """``(texels (BAND_TEXELS, 1, 3) uint8, gain)``: the bands as texture rows
         relative to their mean, and the factor on ``rgba`` that keeps texels <= 1."""

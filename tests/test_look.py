@@ -198,14 +198,15 @@ def test_no_object_is_drawn_brighter_than_a_frame_can_hold(scenario):
     nearest_gain = float(look.light_table()[look.THING].max())
     for obj in mjmaze.registry.get(scenario).task.objects:
         colours = [obj.rgba] + ([two_colour.ITEM_GREEN, two_colour.ITEM_RED] if scenario == "two_colour" else [])
-        brightest = max(max(colour[:3]) for colour in colours) * (palette.AMBIENT + obj.glow) * 255 * nearest_gain
+        brightest = max(obj.unlit(colour).max() for colour in colours) * 255 * nearest_gain
         assert brightest < 255, obj.name
 
 
 def test_two_colour_items_differ_more_than_the_whole_sprites_means():
     # The sprites' means share the grey plates: the parts are what tell the two colours apart.
     # (As GL draws them: the items glow, the means do not.)
-    parts = np.subtract(two_colour.ITEM_GREEN[:3], two_colour.ITEM_RED[:3]) * (palette.AMBIENT + two_colour.ITEMS[0].glow)
+    item = two_colour.ITEMS[0]
+    parts = item.unlit(two_colour.ITEM_GREEN) - item.unlit(two_colour.ITEM_RED)
     means = np.subtract(palette.GREEN_ARMOUR_RGBA[:3], palette.RED_ARMOUR_RGBA[:3]) * palette.AMBIENT
     assert np.linalg.norm(parts) > 2 * np.linalg.norm(means)
 
@@ -247,7 +248,7 @@ def test_k_items_first_two_kinds_are_the_released_armours_as_vizdoom_draws_them(
     physics = env.physics
     stand_in = two_colour.ITEMS[0]  # a floor cylinder of the armour's size, which glows: dimmed to draw as K-item's
     ids = physics.object_ids([stand_in.name])
-    physics.set_object_rgba(ids[1][0], (*np.multiply(green.rgba[:3], palette.AMBIENT / (palette.AMBIENT + stand_in.glow)), 1.0))
+    physics.set_object_rgba(ids[1][0], (*green.unlit() / stand_in.unlit((1.0, 1.0, 1.0)), 1.0))
     physics.show_objects(ids[1], True)
     physics.place_objects(ids[0], np.array([[2.0, 0.0]]))
     # ViZDoom's green armour 2 m ahead in the STONE2 room (the Labyrinth exit's measurement): (49, 59, 37).
