@@ -9,6 +9,13 @@
     python tools/doom_frames.py --light         # Doom's light over depth: both walls' sides, floor, ceiling
     python tools/doom_frames.py --two-colour RELEASED_REPO/scenarios/basefiles/two_color_basefile.wad
                                             # the released Two-colour script played: health changes, tics survived
+    python tools/doom_frames.py --calibrate --freedoom paper  # ... with the paper's Freedoom 0.10.1
+
+``--freedoom`` picks the game data ViZDoom draws with (``vizdoom``, the
+default: the installed ViZDoom's own, Freedoom 0.13.0 in ViZDoom 1.3.2, which
+mjmaze's look was measured on through 2026-11-26; ``paper``: Freedoom 0.10.1,
+what the paper's ViZDoom 1.1.4 drew and its agents saw; or a wad's path; see
+``tools/paper_agents_vizdoom.py``).
 
 Needs ViZDoom (``pip install -e ".[bench]"``; it draws Freedoom's textures and
 sprites, as the paper's runs did). The Doom map of an mjmaze maze is built the
@@ -37,6 +44,9 @@ import numpy as np
 import mjmaze
 from mjmaze import configs, look, maze, mjcf, palette, walls
 from mjmaze.tasks import base, find_return, k_item, two_colour
+
+#: The game data ViZDoom draws with (``--freedoom``): None, the installed ViZDoom's own.
+GAME_WAD: str | None = None
 
 UNITS = 128  # Doom map units per metre (mjmaze's 1 m cell is the generator's 128 units)
 WALL_PAD = 8  # the generator's half thickness of a wall block
@@ -143,6 +153,8 @@ def released_game(wad: pathlib.Path, weapon: bool = True, variables=(), buttons=
     import vizdoom as vzd
 
     game = vzd.DoomGame()
+    if GAME_WAD is not None:
+        game.set_doom_game_path(GAME_WAD)
     game.set_doom_scenario_path(str(wad))
     game.set_doom_map("map01")
     game.set_screen_resolution(vzd.ScreenResolution.RES_320X180)
@@ -597,7 +609,13 @@ def main() -> None:
     parser.add_argument("--projection", action="store_true", help="print ViZDoom's focal lengths beside mjmaze's")
     parser.add_argument("--light", action="store_true", help="print Doom's light over depth beside mjmaze's")
     parser.add_argument("--episodes", type=int, default=32, help="episodes for --two-colour")
+    parser.add_argument("--freedoom", default="vizdoom", metavar="vizdoom|paper|PATH",
+                        help="the game data: vizdoom (default: ViZDoom's own), paper (Freedoom 0.10.1) or a wad")
     args = parser.parse_args()
+    global GAME_WAD
+    from paper_agents_vizdoom import freedoom_path  # this script's folder is on the path
+
+    GAME_WAD = freedoom_path(args.freedoom)
     if args.light:
         light()
     elif args.projection:

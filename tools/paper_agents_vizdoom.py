@@ -5,6 +5,7 @@
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --agreement two_colour_1  # ... with ViZDoom's items placed
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --picks two_colour_5      # right and wrong picks, both engines
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --shift 1 --out F         # frames moved 1 px: the probe's scale
+    python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --freedoom vizdoom --out F # ViZDoom's own Freedoom 0.13
 
 RELEASED_CHECKOUT is a checkout of github.com/edbeeching/3d_control_deep_rl
 (its ``3dcdrl/scenarios/custom_scenarios/`` holds each maze's ``.cfg``/``.wad``,
@@ -17,8 +18,14 @@ argmax action, the GRU wiped at each episode's start. ViZDoom runs as the
 released env ran it (``doom_environment.py``): the maze's released ``.cfg``,
 320x180, the ``--limit_actions`` buttons (left, right, forward, forward+left,
 forward+right), 4 tics per action, head-bob on, the frame resized to 112x64
-with ``cv2.INTER_AREA``. The metric is read off the rewards the released
-scripts pay: Labyrinth's exit (+1), Find-and-return's two +0.5 (the pillar,
+with ``cv2.INTER_AREA``, and the game data the paper's agents were trained on:
+the released README asks for ViZDoom 1.1.4, whose build downloaded Freedoom
+0.10.1 (``scripts/download_freedoom.sh``); ViZDoom 1.3.2 ships Freedoom 0.13.0,
+whose armours, medikit and soulsphere are other pictures (its soulsphere is
+gold, 0.10.1's blue). ``--freedoom paper`` (the default) fetches 0.10.1's
+``freedoom2.wad`` once from Ubuntu's archive (the Debian package
+``freedoom_0.10.1-1``, BSD licence) into mjmaze's cache. The metric is read
+off the rewards the released scripts pay: Labyrinth's exit (+1), Find-and-return's two +0.5 (the pillar,
 then the start), K-item's +0.5 per item in order; Two-colour's duration is
 4 tics per step, as mjmaze counts it. Writes ``--out`` (default
 ``runs/paper/vizdoom.json``): one evaluation per agent, in ``evaluate``'s
@@ -28,9 +35,13 @@ format, which ``paper_table --vizdoom`` puts beside mjmaze's.
 from __future__ import annotations
 
 import argparse
+import hashlib
+import io
 import json
 import multiprocessing as mp
 import pathlib
+import tarfile
+import urllib.request
 
 import numpy as np
 import torch
@@ -46,13 +57,56 @@ SIZE = (112, 64)
 PLAYS_PER_MAZE = 2
 BATCH = 16  # mazes played side by side (one network batch)
 DEFAULT_OUT = pathlib.Path("runs/paper/vizdoom.json")  # what paper_table --vizdoom reads by default
+# The paper's Freedoom: ViZDoom 1.1.4 (the released README's) built with Freedoom 0.10.1.
+PAPER_FREEDOOM_DEB = "http://archive.ubuntu.com/ubuntu/pool/universe/f/freedoom/freedoom_0.10.1-1_all.deb"
+PAPER_FREEDOOM_SHA256 = "91c2b5a7454f684dc0141ea50086e94ae0483c9ab04ba97393bb47e703e18c63"  # its freedoom2.wad
 
 
-def _game(cfg: pathlib.Path, seed: int = 0, objects: bool = False):
+def paper_freedoom() -> pathlib.Path:
+    """Freedoom 0.10.1's ``freedoom2.wad``, the game data the paper's agents saw, fetched once into the cache."""
+    target = paper_agents.cache_dir() / "freedoom-0.10.1" / "freedoom2.wad"
+    if target.exists():
+        return target
+    try:
+        with urllib.request.urlopen(PAPER_FREEDOOM_DEB, timeout=120) as response:
+            deb = response.read()
+    except (urllib.error.URLError, TimeoutError, OSError) as error:
+        raise SystemExit(f"error: could not download {PAPER_FREEDOOM_DEB} ({error}); pass --freedoom PATH to a "
+                         "Freedoom 0.10.1 freedoom2.wad, or --freedoom vizdoom for ViZDoom's own") from None
+    # A .deb is an ar archive (a 60-byte header per member); the files are in data.tar.*.
+    offset = 8
+    while offset < len(deb):
+        name, size = deb[offset:offset + 16].decode().strip().rstrip("/"), int(deb[offset + 48:offset + 58])
+        if name.startswith("data.tar"):
+            with tarfile.open(fileobj=io.BytesIO(deb[offset + 60:offset + 60 + size])) as tar:
+                wad = tar.extractfile("./usr/share/games/doom/freedoom2.wad").read()
+            break
+        offset += 60 + size + size % 2
+    else:
+        raise SystemExit(f"error: {PAPER_FREEDOOM_DEB} holds no data archive")
+    if hashlib.sha256(wad).hexdigest() != PAPER_FREEDOOM_SHA256:
+        raise SystemExit(f"error: the freedoom2.wad in {PAPER_FREEDOOM_DEB} is not Freedoom 0.10.1's; nothing cached")
+    return files.atomic_write_bytes(target, wad)
+
+
+def freedoom_path(choice: str) -> str | None:
+    """``--freedoom``'s game data: ``paper`` (0.10.1), ``vizdoom`` (None: ViZDoom's own) or a wad's path."""
+    if choice == "paper":
+        return str(paper_freedoom())
+    if choice == "vizdoom":
+        return None
+    if not pathlib.Path(choice).is_file():
+        raise SystemExit(f"error: --freedoom {choice}: no such file (paper, vizdoom or a freedoom2.wad)")
+    return choice
+
+
+def _game(cfg: pathlib.Path, seed: int = 0, objects: bool = False, wad: str | None = None):
     import vizdoom as vzd
 
     game = vzd.DoomGame()
     game.load_config(str(cfg))
+    if wad is not None:
+        game.set_doom_game_path(wad)  # the released .cfg names none: ViZDoom's own freedoom2.wad
     game.set_seed(seed)  # Doom's random spawn heading and item draws: the same episodes on every run
     game.set_screen_resolution(vzd.ScreenResolution.RES_320X180)  # as the released env sets it after the cfg
     game.set_sound_enabled(False)
@@ -86,7 +140,7 @@ def _metric(scenario: str, rewards: list[float], steps: int, num_items: int | No
     return float(steps * FRAME_SKIP)  # two_colour: tics survived
 
 
-def play(job: tuple[str, str, str, int, int, int]) -> tuple[str, str, dict]:
+def play(job: tuple[str, str, str, int, int, int, str | None]) -> tuple[str, str, dict]:
     """Plays one agent on one split's first 64 mazes, each ``plays`` times; returns ``(name, split, result)``.
 
     Maze ``i``'s game is seeded with ``seed * 1000 + i`` (Doom's random draws:
@@ -96,7 +150,7 @@ def play(job: tuple[str, str, str, int, int, int]) -> tuple[str, str, dict]:
     sideways (0: as released), the probe's scale in closed loop: how far a
     score moves for a change no one would call an engine's.
     """
-    name, split, checkout, seed, plays_per_maze, shift = job
+    name, split, checkout, seed, plays_per_maze, shift, wad = job
     torch.set_num_threads(1)
     info = paper_agents.get(name)
     _, agent, _ = paper_agents.load(name, paper_dir=checkout)
@@ -107,7 +161,8 @@ def play(job: tuple[str, str, str, int, int, int]) -> tuple[str, str, dict]:
     mazes = list(range(paper_agents.MAZES_PER_SPLIT))
     for first in range(0, len(mazes), BATCH):
         batch = mazes[first:first + BATCH]
-        games = [_game(folder / f"custom_scenario{index:03d}.cfg", seed=_maze_seed(seed, index)) for index in batch]
+        games = [_game(folder / f"custom_scenario{index:03d}.cfg", seed=_maze_seed(seed, index), wad=wad)
+                 for index in batch]
         plays = [0] * len(games)
         rewards = [[] for _ in games]
         hidden = agent.initial_state(len(games))
@@ -146,7 +201,8 @@ def play(job: tuple[str, str, str, int, int, int]) -> tuple[str, str, dict]:
     }
 
 
-def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False) -> tuple[float, float, dict]:
+def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False,
+              wad: str | None = None) -> tuple[float, float, dict]:
     """How often the agent chooses, on mjmaze's frame, the action it chose on ViZDoom's frame at the same pose.
 
     Returns that share, for scale the share on ViZDoom's own frames moved
@@ -183,7 +239,7 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
     for index in range(mazes):
         maze = json.loads((folder / f"custom_scenario{index:03d}.json").read_text())
         centre = np.mean(np.array(maze["exterior"], dtype=float), axis=0)  # mjmaze centres the maze on (0, 0)
-        game = _game(folder / f"custom_scenario{index:03d}.cfg", seed=index, objects=two_colour)
+        game = _game(folder / f"custom_scenario{index:03d}.cfg", seed=index, objects=two_colour, wad=wad)
         path = []
         hidden, start = agent.initial_state(1), torch.ones(1, dtype=torch.bool)
         health, flashes = game.get_game_variable(vzd.GameVariable.HEALTH), [0, 0]  # damage, bonus counts
@@ -245,7 +301,7 @@ def frame_gaps(doom: np.ndarray, ours: np.ndarray, block: int = 8) -> tuple[floa
             float(np.abs(a.mean(axis=0) - b.mean(axis=0)).mean()))
 
 
-def picks(name: str, checkout: str, mazes: int = 32) -> dict[str, dict]:
+def picks(name: str, checkout: str, mazes: int = 32, wad: str | None = None) -> dict[str, dict]:
     """A Two-colour agent's picks in both engines: right and wrong items per 100 tics, by the totem's colour.
 
     The agent plays the first ``mazes`` test mazes twice, greedily, in each
@@ -269,7 +325,8 @@ def picks(name: str, checkout: str, mazes: int = 32) -> dict[str, dict]:
     for index in range(mazes):
         maze = json.loads((folder / f"custom_scenario{index:03d}.json").read_text())
         centre = np.mean(np.array(maze["exterior"], dtype=float), axis=0)
-        game = _game(folder / f"custom_scenario{index:03d}.cfg", seed=_maze_seed(1, index), objects=True)
+        game = _game(folder / f"custom_scenario{index:03d}.cfg", seed=_maze_seed(1, index), objects=True,
+                     wad=wad)
         game.add_available_game_variable(vzd.GameVariable.USER1)  # the script's global 1, shaping_reward (fixed point)
         for play_index in range(PLAYS_PER_MAZE):
             if play_index:
@@ -375,25 +432,29 @@ def main() -> None:
                         help="instead: how often a Labyrinth or Two-colour agent acts alike on both engines' frames "
                              "at the same poses, and how far apart the engines' frames are there")
     parser.add_argument("--mazes", type=int, default=8, help="test mazes for --agreement (default 8)")
+    parser.add_argument("--freedoom", default="paper", metavar="paper|vizdoom|PATH",
+                        help="the game data: paper (default: Freedoom 0.10.1, as the paper's ViZDoom 1.1.4 had it; "
+                             "fetched once), vizdoom (the installed ViZDoom's own), or a freedoom2.wad")
     args = parser.parse_args()
+    wad = freedoom_path(args.freedoom)
     if args.agreement:
         scenario = paper_agents.get(args.agreement).scenario
         if scenario not in ("labyrinth", "two_colour"):
             raise SystemExit("error: --agreement takes a Labyrinth or Two-colour agent (labyrinth_7 .. two_colour_7)")
         if args.mazes < 1:
             raise SystemExit(f"error: --mazes must be 1 or more, got {args.mazes}")
-        share, shifted, gap = agreement(args.agreement, str(args.checkout), mazes=args.mazes)
+        share, shifted, gap = agreement(args.agreement, str(args.checkout), mazes=args.mazes, wad=wad)
         print(f"{args.agreement}: the same action at {share:.1%} of the poses of its ViZDoom episodes (first "
               f"{args.mazes} test mazes); on ViZDoom's own frames moved 1 pixel sideways: {shifted:.1%}")
         print(f"  the frames' mean grey difference at those poses: {gap['pixel']:.2f} per pixel, {gap['block']:.2f} "
               f"in 8x8 blocks, {gap['column']:.2f} per column")
         if scenario == "two_colour":
-            hidden = agreement(args.agreement, str(args.checkout), mazes=args.mazes, hide_items=True)[0]
+            hidden = agreement(args.agreement, str(args.checkout), mazes=args.mazes, hide_items=True, wad=wad)[0]
             print(f"  with mjmaze's items hidden: {hidden:.1%}")
         return
     if args.picks:
         try:
-            table = picks(args.picks, str(args.checkout))
+            table = picks(args.picks, str(args.checkout), wad=wad)
         except ValueError as error:
             raise SystemExit(f"error: {error}") from None
         print(f"{args.picks}, first 32 test mazes twice: | engine | totem | episodes | tics | right | wrong "
@@ -415,13 +476,14 @@ def main() -> None:
         raise SystemExit(f"error: --shift {args.shift} plays ViZDoom with moved frames: pass --out FILE other than "
                          f"{DEFAULT_OUT}")
     results = json.loads(args.out.read_text()) if args.out.exists() else {}  # kept: rerun only what is asked
-    jobs = [(name, split, str(args.checkout), args.seed, args.plays, args.shift)
+    jobs = [(name, split, str(args.checkout), args.seed, args.plays, args.shift, wad)
             for name in names for split in ("train", "test")]
     with mp.get_context("spawn").Pool(args.processes) as pool:
         for name, split, result in pool.imap_unordered(play, jobs):
             info = paper_agents.get(name)
             entry = results.setdefault(name, {
-                "run": paper_agents.PREFIX + name, "engine": f"vizdoom {__import__('vizdoom').__version__}",
+                "run": paper_agents.PREFIX + name, "engine": f"vizdoom {__import__('vizdoom').__version__}, freedoom "
+                          f"{ {'paper': '0.10.1', 'vizdoom': 'as shipped'}.get(args.freedoom, args.freedoom)}",
                 "step": info.observations, "scenario": info.scenario, "task_kwargs": info.task_kwargs,
                 "units": suite.paper_metric(info.scenario)[2]})
             entry[split] = result
