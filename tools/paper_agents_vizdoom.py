@@ -478,14 +478,16 @@ def main() -> None:
     results = json.loads(args.out.read_text()) if args.out.exists() else {}  # kept: rerun only what is asked
     jobs = [(name, split, str(args.checkout), args.seed, args.plays, args.shift, wad)
             for name in names for split in ("train", "test")]
+    engine = (f"vizdoom {__import__('vizdoom').__version__}, freedoom "
+              f"{ {'paper': '0.10.1', 'vizdoom': 'as shipped'}.get(args.freedoom, args.freedoom)}")
     with mp.get_context("spawn").Pool(args.processes) as pool:
         for name, split, result in pool.imap_unordered(play, jobs):
             info = paper_agents.get(name)
-            entry = results.setdefault(name, {
-                "run": paper_agents.PREFIX + name, "engine": f"vizdoom {__import__('vizdoom').__version__}, freedoom "
-                          f"{ {'paper': '0.10.1', 'vizdoom': 'as shipped'}.get(args.freedoom, args.freedoom)}",
-                "step": info.observations, "scenario": info.scenario, "task_kwargs": info.task_kwargs,
-                "units": suite.paper_metric(info.scenario)[2]})
+            if results.get(name, {}).get("engine") != engine:  # no split of other game data stays beside it
+                results[name] = {"run": paper_agents.PREFIX + name, "engine": engine, "step": info.observations,
+                                 "scenario": info.scenario, "task_kwargs": info.task_kwargs,
+                                 "units": suite.paper_metric(info.scenario)[2]}
+            entry = results[name]
             entry[split] = result
             files.atomic_write_json(args.out, results)  # after each job: an interrupted run keeps what it did
             print(f"{name} {split}: {result['value']:.3g} {entry['units']}, mean length {result['mean_length']:.0f} "
