@@ -57,7 +57,7 @@ class EpisodeState(TypedDict, total=False):
     pose: Any  #: ``(B, 3)`` float64: the spawn (x, y, yaw), set by ``start``
     object_xy: Any  #: ``(B, objects, 2)`` float64: where each object is
     object_shown: Any  #: ``(B, objects)`` bool: which objects are in the arena
-    object_rgba: Any  #: ``(B, objects, 4)`` float64, optional: the episode's colours
+    object_rgba: Any  #: ``(B, k, 4)`` float64, optional: the episode's colours of the first k objects
     key: Any  #: ``(B,)`` int64: the episode's key for :func:`mjmaze.rules.uniform`
     steps: Any  #: ``(B,)`` int64: agent steps taken
     episode_return: Any  #: ``(B,)`` float64: the return so far
@@ -169,7 +169,7 @@ class MazeRules(abc.ABC):
         Returns a dict of ``(B, ...)`` arrays with at least ``pose`` ``(B, 3)``
         (the spawn: x, y, yaw), ``object_xy`` ``(B, len(objects), 2)`` and
         ``object_shown`` ``(B, len(objects))``; optionally ``object_rgba``
-        ``(B, len(objects), 4)`` (colours for this episode); plus the scenario's own
+        ``(B, k, 4)`` (this episode's colours of the first ``k`` objects); plus the scenario's own
         fields. Random draws come from :func:`mjmaze.rules.uniform` with ``keys``.
         """
 

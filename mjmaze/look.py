@@ -197,4 +197,6 @@ class DoomLight:
         code = xp.where(depth > plane, xp.where(up < 0, _ON_FLOOR, _ON_CEILING), code)
         bins = xp.astype(rules.at_most(xp, (_LIGHT_BINS * _NEAREST) / depth, _LIGHT_BINS - 1), xp.int32)
         gain = xp.take(self._gains, xp.reshape(code * _LIGHT_BINS + bins, (-1,)), axis=0)
-        return xp.astype(xp.astype(frames, xp.float32) * xp.reshape(gain, frames.shape) + 0.5, xp.uint8)
+        # Saturate, as Doom's brightest colormap does: a bright sprite near the eye goes past 255.
+        lit = rules.at_most(xp, xp.astype(frames, xp.float32) * xp.reshape(gain, frames.shape), 254.5)
+        return xp.astype(lit + 0.5, xp.uint8)

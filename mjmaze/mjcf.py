@@ -18,7 +18,7 @@ from collections.abc import Sequence
 import mujoco
 import numpy as np
 
-from mjmaze import palette, walls
+from mjmaze import palette, sprites, walls
 
 #: ``visual_style`` values: "textured" (the default) gives walls and floor
 #: textures whose texels keep their size in the world and light that falls off
@@ -27,7 +27,6 @@ from mjmaze import palette, walls
 VISUAL_STYLES = ("textured", "flat")
 
 
-BAND_TEXELS = 100  # texture rows for an object's bands (their shares are in hundredths)
 #: Side of the floor's quads. Chosen when a lamp lit the floor at their
 #: corners (with 1 m quads the floor under the eye flashed 2.5x brighter each
 #: time the agent passed a corner; 0.5 m cost ~30 us of a frame on llvmpipe).
@@ -58,11 +57,12 @@ class ObjectGeom:
     about twice as dear with Two-colour's 90 items (43 against 21 us per 4 tics).
     ``z`` is the height of the geom's centre. Objects start hidden.
 
-    ``bands`` (textured style only): the sprite's pixels from top to bottom as
-    ``(share, rgb)`` bands, drawn as a texture on the side of a cylinder, scaled
-    so that their mean is ``rgba`` (the calibrated mean colour, which maps and
-    the flat style show). Bands vary only with height: a cylinder shows the same
-    side from every direction, as a sprite, where a left-right pattern would turn.
+    ``sprite`` (textured style only): Doom's picture of the thing
+    (:mod:`mjmaze.sprites`), drawn on a flat mesh in the thing's spot that the
+    renderers turn to face the camera every frame, as Doom draws a sprite (a
+    world geom's ``geom_quat``: :func:`face_camera`); ``type``, ``size`` and
+    ``rgba`` then serve the flat style and maps, which show the sprite's mean
+    colour on a cylinder. A sprite object cannot collide.
 
     ``glow``: the object's material emission. GL draws it ``rgba x (AMBIENT +
     glow)`` before Doom's light, so a thing brighter than the ambient light can
@@ -75,40 +75,51 @@ class ObjectGeom:
     rgba: tuple[float, float, float, float]
     z: float
     collides: bool = False
-    bands: tuple[tuple[float, tuple[float, float, float]], ...] = ()
+    sprite: sprites.Sprite | None = None
     glow: float = 0.0
+
+    def __post_init__(self):
+        if self.sprite is not None and self.collides:
+            raise ValueError(f"{self.name}: a sprite object cannot collide (its geom turns to face the camera)")
 
     def unlit(self, rgba=None) -> np.ndarray:
         """The RGB (0-1) GL draws the object in before Doom's light, in ``rgba`` (default: its own)."""
         return np.asarray(self.rgba if rgba is None else rgba, dtype=float)[:3] * (palette.AMBIENT + self.glow)
 
-    def band_texels(self) -> tuple[np.ndarray, float]:
-        """``(texels (BAND_TEXELS, 1, 3) uint8, gain)``: the bands as texture rows
-        relative to their mean, and the factor on ``rgba`` that keeps texels <= 1."""
-        shares = np.array([share for share, _ in self.bands])
-        colours = np.array([rgb for _, rgb in self.bands])
-        if abs(shares.sum() - 1) > 1e-6:
-            raise ValueError(f"{self.name}: band shares must sum to 1, got {shares.sum()}")
-        relative = colours / (shares @ colours)
-        gain = float(relative.max())
-        rows = np.repeat(np.arange(len(shares)), np.round(shares * BAND_TEXELS).astype(int))[:BAND_TEXELS]
-        rows = np.concatenate([rows, np.full(BAND_TEXELS - len(rows), len(shares) - 1)])
-        texels = np.round(relative[rows] / gain * 255).astype(np.uint8)
-        return texels[:, None, :], gain
-
 
 def floor_thing(name: str, shape: str, width: float, height: float, rgba, collides: bool = False,
-                glow: float = 0.0) -> ObjectGeom:
+                glow: float = 0.0, sprite: sprites.Sprite | None = None) -> ObjectGeom:
     """A Doom thing on the floor, ``width`` x ``height`` map units (its sprite's size), as an object geom.
 
-    A sprite always faces the camera; a cylinder (``shape="cylinder"``, or a
-    ``"sphere"`` of diameter ``width``) shows the same width from every side.
-    ``glow``: see :class:`ObjectGeom`.
+    ``sprite``: Doom's picture, which the textured style draws facing the
+    camera; otherwise (and in the flat style and maps) a cylinder
+    (``shape="cylinder"``, or a ``"sphere"`` of diameter ``width``) in ``rgba``
+    shows the same width from every side. ``glow``: see :class:`ObjectGeom`.
     """
     radius, height = width / 2 * MAP_UNIT, height * MAP_UNIT
     if shape == "sphere":
-        return ObjectGeom(name, "sphere", (radius,), rgba, radius, collides, glow=glow)
-    return ObjectGeom(name, "cylinder", (radius, height / 2), rgba, height / 2, collides, glow=glow)
+        return ObjectGeom(name, "sphere", (radius,), rgba, radius, collides, sprite=sprite, glow=glow)
+    return ObjectGeom(name, "cylinder", (radius, height / 2), rgba, height / 2, collides, sprite=sprite, glow=glow)
+
+
+def sprite_thing(name: str, sprite: sprites.Sprite) -> ObjectGeom:
+    """A Doom item lying on the floor drawn as its ``sprite``; a cylinder of the
+    picture's width and height in its mean colour in the flat style and maps."""
+    texels = sprites.texture(sprite)[0]
+    return floor_thing(name, "cylinder", texels.shape[1], texels.shape[0], (*sprites.mean_colour(sprite), 1.0),
+                       sprite=sprite)
+
+
+def face_camera(xp, yaw):
+    """The ``geom_quat`` ``(B, 4)`` that turns a sprite's geom to face cameras of headings ``yaw`` ``(B,)`` (radians).
+
+    Doom draws a sprite in the view plane, whatever the angle to it: the
+    picture's plane turns with the camera's heading (numpy or torch, as
+    :mod:`mjmaze.rules`).
+    """
+    half = yaw / 2
+    zero = xp.zeros_like(half)
+    return xp.stack([xp.cos(half), zero, zero, xp.sin(half)], axis=-1)
 
 
 def template_path(name: str = "arena.xml"):
@@ -203,16 +214,8 @@ def build_xml(
     for obj in objects:  # see ObjectGeom
         rgba = obj.rgba
         attrs = dict(name=obj.name, type=obj.type, size=" ".join(map(str, obj.size)))
-        if obj.bands and visual_style == "textured":
-            # GL multiplies the texels by the geom's colour (a geom colour other
-            # than the default overrides the material's, in MuJoCo and MuJoCo Warp).
-            texels, gain = obj.band_texels()
-            ET.SubElement(asset, "texture", name=obj.name, type="2d", builtin="flat",
-                          width=str(texels.shape[1]), height=str(texels.shape[0]), rgb1="1 1 1")
-            ET.SubElement(asset, "material", name=obj.name, texture=obj.name, emission=str(obj.glow),
-                          specular="0", shininess="0", reflectance="0")
-            attrs["material"] = obj.name
-            rgba = (*np.minimum(np.array(obj.rgba[:3]) * gain, 1.0).round(4).tolist(), obj.rgba[3])
+        if obj.sprite is not None and visual_style == "textured":
+            attrs, rgba = _add_sprite(asset, obj)
         elif obj.glow:
             # One material per glow (Two-colour's 90 items share one).
             material = f"glow_{obj.glow}"
@@ -301,13 +304,93 @@ def _ambient_light(root: ET.Element) -> None:
 
 def paint_textures(model: mujoco.MjModel, objects: Sequence[ObjectGeom] = ()) -> None:
     """Fills the textures of a ``"textured"`` model: walls and floor (a fixed
-    pattern, the same everywhere) and the bands of ``objects`` that have them."""
-    banded = [(obj.name, obj.band_texels()[0]) for obj in objects if obj.bands]
-    for name, texels in (("wall", palette.brick_texels()), ("floor", palette.tile_texels()), *banded):
-        texture = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXTURE, name)
-        if texture < 0:
-            continue
+    pattern, the same everywhere), and the pictures and meshes of ``objects``'
+    sprites (:func:`write_sprites`)."""
+    for name, texels in (("wall", palette.brick_texels()), ("floor", palette.tile_texels())):
+        _paint(model, name, texels)
+    write_sprites(model, objects)
+
+
+def _paint(model: mujoco.MjModel, texture_name: str, texels: np.ndarray) -> None:
+    texture = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXTURE, texture_name)
+    if texture >= 0:
         adr, size = model.tex_adr[texture], texels.size
         model.tex_data[adr : adr + size] = texels.ravel()
+
+
+def _sprite_asset(sprite: sprites.Sprite) -> str:
+    return f"sprite_{sprite.name}"
+
+
+def _add_sprite(asset: ET.Element, obj: ObjectGeom) -> tuple[dict, tuple]:
+    """The mesh, texture and material of ``obj``'s sprite (once per sprite); ``(geom attributes, rgba)``.
+
+    GL draws a texel ``texel x rgba x (AMBIENT + emission)`` before Doom's
+    light: white texels at the picture's brightness (:func:`mjmaze.sprites.texture`).
+    """
+    name = _sprite_asset(obj.sprite)
+    texels, brightness, _, _ = sprites.texture(obj.sprite)
+    if asset.find(f"mesh[@name='{name}']") is None:
+        # Compiled from the quads nudged apart (the compiler merges no vertex
+        # and finds a volume), recentred by it: write_sprites writes them as they are.
+        verts, texcoords = sprites.mesh_quads(obj.sprite, obj.z, MAP_UNIT)
+        verts[..., 0] += np.arange(4) * 1e-3
+        faces = np.array([(0, 1, 2), (0, 2, 3)])[None] + (np.arange(len(verts)) * 4)[:, None, None]
+        ET.SubElement(asset, "mesh", name=name, inertia="shell",
+                      vertex=" ".join(f"{v:.5f}" for v in verts.ravel()),
+                      face=" ".join(map(str, faces.ravel())),
+                      texcoord=" ".join(f"{v:.5f}" for v in texcoords.ravel()))
+        ET.SubElement(asset, "texture", name=name, type="2d", builtin="flat",
+                      width=str(texels.shape[1]), height=str(texels.shape[0]), rgb1="1 1 1")
+        ET.SubElement(asset, "material", name=name, texture=name, emission=f"{max(0.0, brightness - palette.AMBIENT):.4f}",
+                      specular="0", shininess="0", reflectance="0")
+    grey = min(1.0, brightness / palette.AMBIENT)
+    return dict(name=obj.name, type="mesh", mesh=name, material=name), (grey, grey, grey, 1.0)
+
+
+def write_sprites(model: mujoco.MjModel, objects: Sequence[ObjectGeom]) -> None:
+    """Writes the pictures and meshes of ``objects``' sprites into a compiled textured model.
+
+    A mesh's vertices are written as :func:`mjmaze.sprites.mesh_quads` gives
+    them, in the frame of a geom at the object's height (``z``), unrotated
+    until :func:`face_camera` turns it: the compiler's recentring is undone.
+    """
+    for obj in objects:
+        if obj.sprite is None:
+            continue
+        name = _sprite_asset(obj.sprite)
+        mesh = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MESH, name)
+        geom = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, obj.name)
+        if mesh < 0 or model.geom_dataid[geom] != mesh:
+            continue  # the flat style: a cylinder
+        _paint(model, name, sprites.texture(obj.sprite)[0])
+        verts, texcoords = sprites.mesh_quads(obj.sprite, obj.z, MAP_UNIT)
+        verts, texcoords = verts.reshape(-1, 3), texcoords.reshape(-1, 2)
+        if model.mesh_vertnum[mesh] != len(verts) or model.mesh_texcoordnum[mesh] != len(texcoords):
+            raise RuntimeError(f"the compiled mesh {name} is not its quads: vertices were merged")
+        faces = (np.array([(0, 1, 2), (0, 2, 3)])[None] + (np.arange(len(verts) // 4) * 4)[:, None, None]).reshape(-1, 3)
+        vert_adr, face_adr = model.mesh_vertadr[mesh], model.mesh_faceadr[mesh]
+        model.mesh_vert[vert_adr : vert_adr + len(verts)] = verts
+        model.mesh_face[face_adr : face_adr + len(faces)] = faces
+        normal_adr = model.mesh_normaladr[mesh]
+        model.mesh_normal[normal_adr : normal_adr + model.mesh_normalnum[mesh]] = (-1.0, 0.0, 0.0)
+        model.mesh_facenormal[face_adr : face_adr + len(faces)] = 0
+        texcoord_adr = model.mesh_texcoordadr[mesh]
+        model.mesh_texcoord[texcoord_adr : texcoord_adr + len(texcoords)] = texcoords
+        model.mesh_facetexcoord[face_adr : face_adr + len(faces)] = faces
+        model.geom_pos[geom, 2] = obj.z
+        model.geom_quat[geom] = (1.0, 0.0, 0.0, 0.0)
+        model.geom_rbound[geom] = 0.0  # 0 = never culled by bounding sphere
+
+
+def sprite_geoms(model: mujoco.MjModel, objects: Sequence[ObjectGeom]) -> np.ndarray:
+    """Geom ids of ``objects`` drawn as sprites in ``model`` (none in the flat style)."""
+    ids = []
+    for obj in objects:
+        if obj.sprite is not None:
+            geom = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, obj.name)
+            if model.geom_type[geom] == mujoco.mjtGeom.mjGEOM_MESH:
+                ids.append(geom)
+    return np.array(ids, dtype=np.int64)
 
 

@@ -2,7 +2,7 @@
 
 Every number here was measured in ViZDoom against mjmaze's frames
 (``python tools/doom_frames.py --calibrate`` and ``--light``; docs/look.md):
-the rooms' mean colours, the things' colours, the armour sprite's bands,
+the rooms' mean colours, the columns' colours, the sprites' brightness,
 Doom's light over depth, and the grey texture patterns with the gains that
 keep each surface's mean colour. :mod:`mjmaze.mjcf` writes them into the
 arena; :class:`mjmaze.look.DoomLight` applies the light.
@@ -41,39 +41,6 @@ SLIME_ROOM = Room(wall=STONE_ROOM.wall, floor=(0.20, 0.40, 0.13), ceiling=(0.0, 
 #: Two-colour's totem) as ViZDoom draws them, on a cylinder of their radius.
 TALL_GREEN_COLUMN_RGBA = (0.24, 0.51, 0.17, 1.0)
 TALL_RED_COLUMN_RGBA = (0.73, 0.06, 0.04, 1.0)
-#: Freedoom's green armour (thing 2018: the Labyrinth exit, Two-colour's green
-#: items) and its "blue" armour (2019), which Freedoom draws red (Two-colour's
-#: red items), averaged over their blink, on a floor cylinder of their size.
-GREEN_ARMOUR_RGBA = (0.52, 0.63, 0.39, 1.0)
-RED_ARMOUR_RGBA = (0.73, 0.31, 0.30, 1.0)
-#: The armours' coloured parts, Two-colour's items: one colour on a cylinder
-#: cannot show a sprite's two parts, and the mean above mixes in the grey
-#: plates both armours share, so green and red items looked more alike than
-#: ViZDoom's and the released agent picked 30-50% fewer (docs/paper_agents.md).
-#: The armours blink: Doom draws picture A lit by the sector for 6 tics, then
-#: the fullbright picture B for 7, which does not fade with depth. ViZDoom
-#: draws the green chest at (20, 41, 13) / (46, 98, 36) (A / B) 2 m ahead and
-#: (23, 48, 15) / (50, 107, 40) 3 m ahead, the red body at (86, 5, 4) /
-#: (139, 11, 11) and (83, 3, 3) / (144, 15, 15) (``python tools/doom_frames.py
-#: --armour-parts``, the slime room). The items show the blink's average, 2
-#: and 3 m ahead, under Doom's light: (36, 76, 27) and (115, 9, 9), each
-#: ``255 x colour x (AMBIENT + ARMOUR_PART_GLOW) x THING_LIGHT`` at 2.5 m. The
-#: red body is brighter than GL's ambient light alone can draw: the items glow
-#: (:attr:`mjmaze.mjcf.ObjectGeom.glow`).
-GREEN_ARMOUR_PART_RGBA = (0.184, 0.389, 0.138, 1.0)
-RED_ARMOUR_PART_RGBA = (0.588, 0.046, 0.046, 1.0)
-ARMOUR_PART_GLOW = 0.28
-#: The green armour's sprite (Freedoom's ARM1, 542 pixels) read from top to
-#: bottom as ``(share of its pixels, their mean colour)``: the grey shoulder
-#: plates, the green chest, the dark lower edge. ViZDoom's frames of the
-#: released maps show it so (51% grey, 26% vivid green: docs/paper_agents.md);
-#: drawn as horizontal bands on the object's side (:attr:`ObjectGeom.bands`),
-#: the olive mean alone hid the vivid part agents look for.
-GREEN_ARMOUR_BANDS = (
-    (0.52, (0.308, 0.297, 0.281)),
-    (0.28, (0.199, 0.422, 0.158)),
-    (0.20, (0.157, 0.136, 0.074)),
-)
 #: The light GL draws every surface with: ambient only, no lamp. Doom's light
 #: (below) is applied to the frame afterwards, per pixel, by its depth
 #: (:class:`mjmaze.look.DoomLight`); mjmaze's surfaces drawn so show
@@ -132,6 +99,17 @@ CEILING_LIGHT = DepthLight(
 _THING_GREY = tuple((north_south + east_west) / 2
                     for north_south, east_west in zip(NORTH_SOUTH_WALL_LIGHT.grey, EAST_WEST_WALL_LIGHT.grey))
 THING_LIGHT = DepthLight(_WALL_DEPTHS, _THING_GREY, 19.0)
+#: Freedoom's sprites (:mod:`mjmaze.sprites`) before Doom's light: GL draws a
+#: sector-lit pixel of palette colour ``P`` (0-1) as ``SPRITE_LIT x P``. The
+#: tall columns' calibrated colours above, drawn ``rgba x AMBIENT``, are their
+#: pictures' (``COL1A0``, ``COL3A0``) mean palette colours times 0.39 in every
+#: channel (green (17, 36, 12) over (44, 92, 34), red 52 over 133).
+SPRITE_LIT = 0.39
+#: A fullbright pixel (the armours' and keycards' blink, the soulsphere):
+#: Doom draws its palette colour whatever the depth; mjmaze's light scales
+#: with depth, so it is drawn as bright as Doom's 2.5 m ahead (over 1-2.5 m
+#: the soulsphere, all fullbright, is then within 16% of ViZDoom's; docs/look.md).
+SPRITE_FULLBRIGHT = float(1 / THING_LIGHT.gain(np.array(2.5)))
 TEXTURE_TEXELS = 64  # per side of a texture; one texture covers 1 m x 1 m
 # 1 / the mean grey of each texture (see _brick_texels, _tile_texels).
 TEXTURE_GAIN = {"wall": 1.35, "floor": 1.6}

@@ -34,6 +34,9 @@ TEXT_COLOUR = (235, 235, 235)
 BACKGROUND = (20, 20, 24)
 # Frame heights are rounded up to this, the block size video encoders want.
 VIDEO_BLOCK = 16
+# A sprite on a map: turned 90 degrees about y (its face, toward -x, then up), just above the floor.
+_FACE_UP = (math.cos(math.pi / 4), 0.0, math.sin(math.pi / 4), 0.0)
+_ABOVE_FLOOR = 0.01
 
 
 class TopDown:
@@ -54,6 +57,10 @@ class TopDown:
             self.physics.model.ptr, mjcf.OVERHEAD_CAMERA, self.size, self.size, map_view=True
         )
         self._wall_mesh = self.physics.model.ptr.mesh(walls.WALL_MESH).id
+        model = self.physics.model.ptr
+        self._sprite_ids = mjcf.sprite_geoms(model, self.task.objects)
+        by_name = {obj.name: obj for obj in self.task.objects}
+        self._sprite_rgba = np.array([by_name[model.geom(int(g)).name].rgba for g in self._sprite_ids]).reshape(-1, 4)
 
     def to_pixels(self, xy) -> np.ndarray:
         """Map pixel ``(column, row)`` of world points ``xy`` (shape ``(..., 2)``)."""
@@ -66,7 +73,19 @@ class TopDown:
         # The task rewrites the wall mesh per maze in the model; this renderer
         # has its own GL copy of it (a few hundred vertices: cheap to resend).
         self._renderer.upload_mesh(self._wall_mesh)
-        return self._renderer.render(self.physics.data.ptr).copy()
+        if not len(self._sprite_ids):
+            return self._renderer.render(self.physics.data.ptr).copy()
+        # A sprite stands upright, edge-on from above: the map lays it on the
+        # floor, face up, in its mean colour (maps draw no textures), then puts it back.
+        model, ids = self.physics.model.ptr, self._sprite_ids
+        saved = model.geom_quat[ids].copy(), model.geom_rgba[ids].copy(), model.geom_pos[ids, 2].copy()
+        model.geom_quat[ids] = _FACE_UP
+        model.geom_rgba[ids] = self._sprite_rgba
+        model.geom_pos[ids, 2] = _ABOVE_FLOOR
+        try:
+            return self._renderer.render(self.physics.data.ptr).copy()
+        finally:
+            model.geom_quat[ids], model.geom_rgba[ids], model.geom_pos[ids, 2] = saved
 
     def draw(
         self,
@@ -112,7 +131,8 @@ class TopDown:
             if model.geom_group[geom] == render.HIDDEN_GROUP:
                 continue
             label = re.sub(r"_?\d+$", "", obj.name).replace("_", " ")
-            entry = (label, tuple(int(round(255 * min(1.0, c))) for c in model.geom_rgba[geom][:3]))
+            rgba = obj.rgba if geom in self._sprite_ids else model.geom_rgba[geom]  # as the map draws it
+            entry = (label, tuple(int(round(255 * min(1.0, c))) for c in rgba[:3]))
             if entry not in entries:
                 entries.append(entry)
         return entries

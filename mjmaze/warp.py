@@ -4,7 +4,7 @@
 gymnasium vector env whose observations, rewards, flags and ``info`` are torch
 tensors on ``device``; reached from the registry by one word::
 
-    envs = gymnasium.make_vec("mjmaze/Labyrinth-v5", num_envs=4096,
+    envs = gymnasium.make_vec("mjmaze/Labyrinth-v6", num_envs=4096,
                               vectorization_mode="vector_entry_point", backend="warp", size=9)
 
 It plays the same task as the CPU envs: the same configurations (splits,
@@ -167,6 +167,7 @@ class MazeBatchEnv(batch.BatchEnv):
         self._wall_visual = geom("walls_visual")
         self._object_ids = torch.tensor([geom(obj.name) for obj in task.objects], dtype=torch.long, device=dev)
         self._object_z = torch.tensor([obj.z for obj in task.objects], dtype=torch.float32, device=dev)
+        self._sprite_ids = torch.as_tensor(mjcf.sprite_geoms(mjm, task.objects), device=dev)
         colliding = [k for k, obj in enumerate(task.objects) if obj.collides]
         self._colliding = torch.tensor(colliding, dtype=torch.long, device=dev)
         self._collision_ids = torch.tensor(
@@ -177,7 +178,8 @@ class MazeBatchEnv(batch.BatchEnv):
 
         textured = task.visual_style == "textured"
         with wp.ScopedDevice(self._wp_device):
-            batched = {"geom_pos": n, "geom_rgba": n, "geom_dataid": n} | ({"cam_pos": n} if task.head_bob else {})
+            batched = ({"geom_pos": n, "geom_rgba": n, "geom_dataid": n} | ({"cam_pos": n} if task.head_bob else {})
+                       | ({"geom_quat": n} if len(self._sprite_ids) else {}))
             self._model = mjw.put_model(mjm, batch_sizes=batched)
             self._data = mjw.put_data(mjm, mujoco.MjData(mjm), nworld=n, nconmax=_CONTACTS_PER_WORLD, njmax=_CONTACTS_PER_WORLD)
             self._render = mjw.create_render_context(
@@ -193,6 +195,7 @@ class MazeBatchEnv(batch.BatchEnv):
         self._warmstart = wp.to_torch(self._data.qacc_warmstart)
         self._geom_pos = wp.to_torch(self._model.geom_pos)
         self._geom_rgba = wp.to_torch(self._model.geom_rgba)
+        self._geom_quat = wp.to_torch(self._model.geom_quat)  # per world with sprites
         self._geom_dataid = wp.to_torch(self._model.geom_dataid)
         self._cam_pos = wp.to_torch(self._model.cam_pos)  # per world with head-bob
         self._camera = mujoco.mj_name2id(mjm, mujoco.mjtObj.mjOBJ_CAMERA, mjcf.EGO_CAMERA)
@@ -338,9 +341,9 @@ class MazeBatchEnv(batch.BatchEnv):
         self._geom_pos[:, self._box_ids, 2] = torch.where(rows, self._box_z[config_index], box_z)
         mesh = self._geom_dataid[:, self._wall_visual]
         self._geom_dataid[:, self._wall_visual] = torch.where(restart, self._mesh_of_config[config_index].int(), mesh)
-        if "object_rgba" in start:
-            rgba = self._geom_rgba[:, self._object_ids]
-            self._geom_rgba[:, self._object_ids] = torch.where(rows[:, :, None], start["object_rgba"].float(), rgba)
+        if "object_rgba" in start:  # the first k objects' colours
+            ids = self._object_ids[: start["object_rgba"].shape[1]]
+            self._geom_rgba[:, ids] = torch.where(rows[:, :, None], start["object_rgba"].float(), self._geom_rgba[:, ids])
 
     def _place_objects(self, state: dict) -> None:
         """Moves every world's objects where ``state`` says; hidden ones below the floor."""
@@ -365,6 +368,8 @@ class MazeBatchEnv(batch.BatchEnv):
         if task.head_bob:
             eye_dz, pistol_dx, pistol_dy = look.view_bob(self.xp, self._bob, self.state["steps"] * core.TICS_PER_STEP)
             self._cam_pos[:, self._camera, 2] = (mjcf.EYE_HEIGHT + eye_dz).float()
+        if len(self._sprite_ids):
+            self._geom_quat[:, self._sprite_ids] = mjcf.face_camera(torch, self._qpos[:, 2:3]).float()
         mjw.kinematics(m, d)  # positions lag a step behind mjw.step's integration
         mjw.camlight(m, d)
         mjw.refit_bvh(m, d, rc)

@@ -35,14 +35,13 @@ import argparse
 import dataclasses
 import math
 import pathlib
-import struct
 import tempfile
 
 import imageio.v3 as iio
 import numpy as np
 
 import mjmaze
-from mjmaze import configs, look, maze, mjcf, palette, walls
+from mjmaze import configs, look, maze, mjcf, palette, sprites, walls
 from mjmaze.tasks import base, find_return, k_item, two_colour
 
 #: The game data ViZDoom draws with (``--freedoom``): None, the installed ViZDoom's own.
@@ -61,7 +60,8 @@ GREEN_ARMOUR, BLUE_ARMOUR, GREEN_COLUMN, RED_COLUMN = 2018, 2019, 30, 32
 LAVA_HEFTY = 83  # the sector special the released Two-colour generator writes (create_sector_toxic)
 # K-item's things in collection order, as the released generator places them (docs/objects.md).
 K_ITEM_THINGS = ((GREEN_ARMOUR, "green armour"), (BLUE_ARMOUR, "blue armour"), (2012, "medikit"),
-                 (2013, "soulsphere"), (13, "red keycard"), (5, "blue keycard"))
+                 (2013, "soulsphere"), (13, "red keycard"), (5, "blue keycard"), (2015, "armour bonus"),
+                 (2014, "health bonus"))
 # Wall patch (centre of the frame), floor band and ceiling band of a 112x64 frame.
 WALL_PATCH = (slice(24, 32), slice(50, 62))
 FLOOR_BAND = (slice(40, 64), slice(0, 40))  # the floor from ~2 m to the frame's foot, left of the pistol
@@ -112,28 +112,10 @@ def textmap(config: configs.MazeConfig, spawn: tuple[float, float, int], things:
     return "\n".join(lines) + "\n"
 
 
-def read_lumps(wad: pathlib.Path) -> dict[bytes, bytes]:
-    """A WAD's lumps by name."""
-    data = wad.read_bytes()
-    count, directory = struct.unpack("<ii", data[4:12])
-    lumps = {}
-    for k in range(count):
-        offset, size, name = struct.unpack("<ii8s", data[directory + 16 * k : directory + 16 * (k + 1)])
-        lumps[name.rstrip(b"\0")] = data[offset : offset + size]
-    return lumps
-
-
 def write_wad(path: pathlib.Path, text: str, behavior: bytes | None = None) -> None:
     """A PWAD holding MAP01 as UDMF (ZDoom builds the nodes when it loads the map), with compiled ACS if given."""
-    lumps = [(b"MAP01", b""), (b"TEXTMAP", text.encode())]
-    lumps += [(b"BEHAVIOR", behavior)] if behavior is not None else []
-    lumps += [(b"ENDMAP", b"")]
-    data, directory, offset = b"", b"", 12
-    for name, body in lumps:
-        directory += struct.pack("<ii8s", offset, len(body), name)
-        data += body
-        offset += len(body)
-    path.write_bytes(b"PWAD" + struct.pack("<ii", len(lumps), offset) + data + directory)
+    lumps = {"MAP01": b"", "TEXTMAP": text.encode()} | ({"BEHAVIOR": behavior} if behavior is not None else {})
+    path.write_bytes(sprites.write_wad(lumps | {"ENDMAP": b""}))
 
 
 def area_resize(frame: np.ndarray, size: tuple[int, int] = SIZE) -> np.ndarray:
@@ -329,13 +311,14 @@ def calibrate() -> None:
     config = env.task.config
     physics = env.physics
     for label, doom_type, name, rgba in (
-        ("green item (green armour)", GREEN_ARMOUR, two_colour.ITEMS[0].name, two_colour.ITEM_GREEN),
-        ("red item (Freedoom's blue armour, red)", BLUE_ARMOUR, two_colour.ITEMS[0].name, two_colour.ITEM_RED),
+        ("green item (green armour)", GREEN_ARMOUR, two_colour.ITEMS[0].name, None),
+        ("red item (Freedoom's blue armour, red)", BLUE_ARMOUR, two_colour.ITEMS[1].name, None),
         ("green totem (tall green column)", GREEN_COLUMN, two_colour.TOTEM.name, two_colour.GREEN),
         ("red totem (tall red column)", RED_COLUMN, two_colour.TOTEM.name, two_colour.RED),
     ):
         ids = physics.object_ids([name])
-        physics.set_object_rgba(ids[1][0], rgba)
+        if rgba is not None:  # the totem's colour is the episode's
+            physics.set_object_rgba(ids[1][0], rgba)
         physics.show_objects(ids[1], True)
         results = []
         for d in (1, 2, 3):
@@ -438,18 +421,17 @@ def armour_parts() -> None:
     7. Per picture, the armour's pixels (labels buffer) split by hue: the
     green armour's green chest, Freedoom's "blue" armour's red body; the rest
     is their grey plates and edges. Two-colour draws each item in its
-    coloured part's colour averaged over the blink (``palette.GREEN_ARMOUR_PART_RGBA``).
+    coloured part's colour averaged over the blink (until ``TwoColour-v7``, which draws the pictures).
     """
     env = empty_arena("slime", pistol=False)
     config, physics = env.task.config, env.physics
-    name = two_colour.ITEMS[0].name
-    ids = physics.object_ids([name])
     print("coloured part, d m ahead: ViZDoom's picture A (sector-lit) / B (fullbright) -> the blink's average "
-          "(6 A + 7 B) / 13 | mjmaze's item")
-    for label, doom_type, channel, margin, rgba in (
-            ("green armour, green part", GREEN_ARMOUR, 1, 10, two_colour.ITEM_GREEN),
-            ("red armour, red part", BLUE_ARMOUR, 0, 30, two_colour.ITEM_RED)):
-        physics.set_object_rgba(ids[1][0], rgba)
+          "(6 A + 7 B) / 13 | mjmaze's item, the same part")
+    for label, doom_type, channel, margin, item in (
+            ("green armour, green part", GREEN_ARMOUR, 1, 10, two_colour.ITEMS[0]),
+            ("red armour, red part", BLUE_ARMOUR, 0, 30, two_colour.ITEMS[1])):
+        name = item.name
+        ids = physics.object_ids([name])
         physics.show_objects(ids[1], True)
         results = []
         for d in (1, 2, 3, 4):
@@ -466,8 +448,11 @@ def armour_parts() -> None:
             average = (ANIMATION_A_TICS * parts[0] + (ANIMATION_TICS - ANIMATION_A_TICS) * parts[1]) / ANIMATION_TICS
             physics.place_objects(ids[0], np.array([[d, 0.0]]))
             frame, mask = mjmaze_view(env, (0.0, 0.0, 0), [name])
+            pixels = frame[mask > 0.99].astype(np.float64)
+            part = pixels[:, channel] > np.delete(pixels, channel, axis=1).max(axis=1) + margin
+            ours = np.round(pixels[part].mean(axis=0)).astype(int).tolist() if part.any() else "-"
             results.append(f"{d} m: " + " / ".join(str(np.round(p).astype(int).tolist()) for p in parts)
-                           + f" -> {np.round(average).astype(int).tolist()} | {mean_colour(frame, mask > 0.99)}")
+                           + f" -> {np.round(average).astype(int).tolist()} | {ours}")
         physics.show_objects(ids[1], False)
         print(f"  {label}:\n    " + "\n    ".join(results))
     env.task.close()
@@ -491,11 +476,10 @@ def item_contrast() -> None:
     empty_doom, _ = doom_tics(textmap(config, (0.0, 0.0, 0), [], SLIME), weapon=False)
     empty_ours, _ = mjmaze_view(env, (0.0, 0.0, 0), [])
     print("Two-colour items d metres ahead: contrast mass, pixels changed by > 60 (Doom | mjmaze)")
-    name = two_colour.ITEMS[0].name
-    ids = physics.object_ids([name])
-    for label, doom_type, rgba in (("green item (green armour)", GREEN_ARMOUR, two_colour.ITEM_GREEN),
-                                   ("red item (Freedoom's blue armour)", BLUE_ARMOUR, two_colour.ITEM_RED)):
-        physics.set_object_rgba(ids[1][0], rgba)
+    for label, doom_type, item in (("green item (green armour)", GREEN_ARMOUR, two_colour.ITEMS[0]),
+                                   ("red item (Freedoom's blue armour)", BLUE_ARMOUR, two_colour.ITEMS[1])):
+        name = item.name
+        ids = physics.object_ids([name])
         physics.show_objects(ids[1], True)
         results = []
         for d in (1, 2, 3, 4):
@@ -556,7 +540,7 @@ def two_colour_script(basefile: pathlib.Path, episodes: int = 32, complexity: in
 
     import vizdoom as vzd
 
-    behavior = read_lumps(basefile)[b"BEHAVIOR"]
+    behavior = sprites.read_wad(basefile.read_bytes())["BEHAVIOR"]
     buttons = [vzd.Button.TURN_LEFT, vzd.Button.TURN_RIGHT, vzd.Button.MOVE_FORWARD]
     actions = [[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [0, 1, 1]]  # mjmaze's default set, in its order
     rng = np.random.default_rng(0)

@@ -94,6 +94,7 @@ class MazeTask(core.MazeRules, base.Task):
         self.horizontal_fov = mjcf.EGO_HORIZONTAL_FOV
         self._config_in_model = None
         self._object_ids = physics.object_ids([geom.name for geom in self.objects])[1]
+        self._sprite_ids = mjcf.sprite_geoms(model, self.objects)
 
     def initialize_episode(self, physics: MazePhysics) -> None:
         self._bind(physics)
@@ -174,6 +175,7 @@ class MazeTask(core.MazeRules, base.Task):
         self._bind(physics)
         pistol_shift = self._bob_view(physics)
         data = self._bound_data
+        self._face_sprites()
         frame = self._renderer.render(data)
         if self._light is not None:
             eye, yaw = data.cam_xpos[self._camera_id], data.qpos[2:3]
@@ -197,7 +199,13 @@ class MazeTask(core.MazeRules, base.Task):
         """``(H, W)``: the geom id the agent sees at each pixel of its view, -1 for none (the sky)."""
         self._bind(physics)
         self._bob_view(physics)
+        self._face_sprites()
         return self._renderer.segmentation(self._bound_data)
+
+    def _face_sprites(self) -> None:
+        """Turns the sprites to face the camera (:func:`mjmaze.mjcf.face_camera`)."""
+        if len(self._sprite_ids):
+            self._model.geom_quat[self._sprite_ids] = mjcf.face_camera(np, self._qpos[2:3])
 
     def _bob_view(self, physics: MazePhysics) -> tuple[int, int]:
         """Puts the eye where head-bob has it now; returns the pistol's shift in pixels (right, down)."""

@@ -22,6 +22,10 @@ The collection order is item kind 1, then 2, ... by the released files' colour
 codes: green, red, blue, cyan, magenta, yellow, then two greys, which also
 differ in shape (:data:`KINDS`).
 Version History
+    * v5 (2026-11-26): every kind drawn as the thing the released generator
+      places, in Freedoom 0.10.1's own pictures (the paper's game data),
+      turning to face the camera as Doom's sprites do; kinds 3-8 were
+      one-colour cylinders in the spec's hues (docs/paper_agents.md, item 17).
     * v4 (2026-11-26): things (exits, items, pillars, totems) lit as Doom
       lights sprites: by the sector's light over depth, between the two
       walls' curves (``palette.THING_LIGHT``); before, the old lamp's curve,
@@ -43,7 +47,7 @@ Version History
 
 from __future__ import annotations
 
-from mjmaze import configs, core, maze, mjcf, palette, registry, rules
+from mjmaze import configs, core, maze, mjcf, registry, rules, sprites
 
 
 NUM_ITEMS = tuple(range(1, 9))
@@ -57,25 +61,22 @@ WRONG_ITEM_REWARD = -0.25
 STEP_REWARD = -0.0001 * core.TICS_PER_STEP
 
 
-# Item kinds in collection order: (colour code in the released files, geom).
-# Sizes are those of the things the released generators place, in this order
-# (docs/objects.md): green armour 2018, blue armour 2019, medikit 2012,
-# soulsphere 2013, red and blue keycards 13 and 5. The first two are drawn in
-# the colours ViZDoom draws those armours (Freedoom's blue armour is red), as
-# Two-colour's items and the Labyrinth exit: the spec's saturated green and red
-# stood out of the dim frame far more than the released olive and dull red
-# (README "Learning", K-item). The others keep the spec's hues: Freedoom's
-# medikit, soulsphere and keycards are not measured yet.
-# The two greys (K = 8) are not in the released files we have: our shapes.
+# Item kinds in collection order: (colour code in the released files, geom),
+# each the thing the released generators place for that code
+# (generate_eight_item.py: item_tids), drawn as Freedoom 0.10.1's picture of
+# it (mjmaze.sprites): green armour 2018, blue armour 2019 (red in Freedoom),
+# medikit 2012, soulsphere 2013 (blue in 0.10.1), red and blue keycards 13
+# and 5, armour bonus 2015, health bonus 2014. The geom names keep the colour
+# codes' names.
 KINDS = (
-    ("g", mjcf.floor_thing("item_green", "cylinder", 31, 17, palette.GREEN_ARMOUR_RGBA)),
-    ("r", mjcf.floor_thing("item_red", "cylinder", 31, 17, palette.RED_ARMOUR_RGBA)),
-    ("b", mjcf.floor_thing("item_blue", "cylinder", 28, 19, (0.15, 0.25, 1.0, 1.0))),
-    ("c", mjcf.floor_thing("item_cyan", "sphere", 24, 24, (0.0, 0.9, 0.9, 1.0))),
-    ("m", mjcf.floor_thing("item_magenta", "cylinder", 14, 16, (0.9, 0.1, 0.9, 1.0))),
-    ("y", mjcf.floor_thing("item_yellow", "cylinder", 14, 16, (1.0, 0.9, 0.0, 1.0))),
-    ("0.5", mjcf.floor_thing("item_grey50", "sphere", 31, 31, (0.5, 0.5, 0.5, 1.0))),
-    ("0.75", mjcf.floor_thing("item_grey75", "cylinder", 18, 41, (0.75, 0.75, 0.75, 1.0))),
+    ("g", mjcf.sprite_thing("item_green", sprites.GREEN_ARMOUR)),
+    ("r", mjcf.sprite_thing("item_red", sprites.BLUE_ARMOUR)),
+    ("b", mjcf.sprite_thing("item_blue", sprites.MEDIKIT)),
+    ("c", mjcf.sprite_thing("item_cyan", sprites.SOULSPHERE)),
+    ("m", mjcf.sprite_thing("item_magenta", sprites.RED_KEYCARD)),
+    ("y", mjcf.sprite_thing("item_yellow", sprites.BLUE_KEYCARD)),
+    ("0.5", mjcf.sprite_thing("item_grey50", sprites.ARMOUR_BONUS)),
+    ("0.75", mjcf.sprite_thing("item_grey75", sprites.HEALTH_BONUS)),
 )
 KIND_OF_CODE = {code: kind for kind, (code, _) in enumerate(KINDS)}
 
@@ -138,7 +139,7 @@ class KItem(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="k_item",
     task=KItem,
-    gym_id="mjmaze/KItem-v4",
+    gym_id="mjmaze/KItem-v5",
     seed_code=3,
     difficulty="num_items",
     difficulties=NUM_ITEMS,

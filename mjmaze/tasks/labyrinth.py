@@ -16,6 +16,9 @@ Arguments
 Metric
     ``success``: whether the exit was reached (success rate = mean over episodes).
 Version History
+    * v6 (2026-11-26): the exit drawn as Freedoom 0.10.1's green armour (the
+      paper's game data), a picture turning to face the camera as Doom's
+      sprites do, instead of a banded cylinder (docs/paper_agents.md, item 17).
     * v5 (2026-11-26): things (exits, items, pillars, totems) lit as Doom
       lights sprites: by the sector's light over depth, between the two
       walls' curves (``palette.THING_LIGHT``); before, the old lamp's curve,
@@ -41,7 +44,7 @@ Version History
 
 from __future__ import annotations
 
-from mjmaze import configs, core, maze, mjcf, palette, registry, rules
+from mjmaze import configs, core, maze, mjcf, registry, rules, sprites
 
 
 SIZES = (5, 7, 9, 11, 13)
@@ -52,17 +55,9 @@ EXIT_REWARD = 1.0
 STEP_REWARD = -0.0001 * core.TICS_PER_STEP
 
 # The released mazes' exit is Doom's green armour (thing 2018): a pickup lying
-# on the floor, 40 x 16 map units (a 31 x 17 sprite), i.e. 0.12 m in radius and
-# 0.125 m high. A cylinder shows the same width from every side, as a sprite.
-# How small it is decides how far off the agent can spot it (docs/objects.md).
-# Its mean colour is the armour's as ViZDoom draws it, blinking, at the
-# released light, a dull olive (docs/look.md); its side shows the sprite's
-# grey plates, vivid green chest and dark edge as bands around that mean.
-EXIT_RADIUS, EXIT_HEIGHT = 0.12, 16 * mjcf.MAP_UNIT
-EXIT = mjcf.ObjectGeom(
-    "exit", "cylinder", (EXIT_RADIUS, EXIT_HEIGHT / 2), palette.GREEN_ARMOUR_RGBA, z=EXIT_HEIGHT / 2,
-    bands=palette.GREEN_ARMOUR_BANDS,
-)
+# on the floor, drawn as Freedoom's picture (31 x 18 map units). How small it
+# is decides how far off the agent can spot it (docs/objects.md).
+EXIT = mjcf.sprite_thing("exit", sprites.GREEN_ARMOUR)
 
 
 class Labyrinth(core.MazeRules):
@@ -97,7 +92,7 @@ class Labyrinth(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="labyrinth",
     task=Labyrinth,
-    gym_id="mjmaze/Labyrinth-v5",
+    gym_id="mjmaze/Labyrinth-v6",
     seed_code=1,
     difficulty="size",
     difficulties=SIZES,

@@ -36,6 +36,10 @@ Arguments
 Metric
     ``duration``: tics survived (max 2100); also ``health`` and ``totem_green``.
 Version History
+    * v7 (2026-11-26): items drawn as Freedoom 0.10.1's own pictures of the
+      green and the "blue" (red) armour (the paper's game data), turning to
+      face the camera as Doom's sprites do, instead of cylinders in their
+      coloured parts' colours (docs/paper_agents.md, item 17).
     * v6 (2026-11-26): items in their coloured parts' colours as ViZDoom
       draws them averaged over the armours' blink, 2-3 m ahead under Doom's
       light (green 8% darker, red 18% brighter; docs/paper_agents.md, item 15).
@@ -67,7 +71,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mjmaze import configs, core, mjcf, palette, registry, rules, walls
+from mjmaze import configs, core, mjcf, palette, registry, rules, sprites, walls
 
 
 COMPLEXITIES = tuple(range(0, 11))
@@ -117,11 +121,8 @@ _CHUNK_ELEMENTS = 1 << 24
 # green column (things 32 / 30, 16 map units in radius and 52 high, as
 # Find-and-return's pillars); the items are Freedoom's green armour and its
 # "blue" armour, which Freedoom draws red (the released ACS calls it the red
-# armour), lying on the floor at their sprites' size, each in the colour of
-# its sprite's coloured part as ViZDoom draws it, averaged over the armour's
-# blink (see palette.GREEN_ARMOUR_PART_RGBA).
+# armour), drawn as their pictures (mjmaze.sprites), alternating, green first.
 RED, GREEN = palette.TALL_RED_COLUMN_RGBA, palette.TALL_GREEN_COLUMN_RGBA
-ITEM_RED, ITEM_GREEN = palette.RED_ARMOUR_PART_RGBA, palette.GREEN_ARMOUR_PART_RGBA
 TOTEM = mjcf.floor_thing("totem", "cylinder", 32, 52, RED, collides=True)
 TOTEM_RADIUS = TOTEM.size[0]
 # The agent's centre never comes closer to the totem's than this.
@@ -129,10 +130,9 @@ TOTEM_CLEARANCE = TOTEM_RADIUS + core.AGENT_RADIUS
 # Where the released map keeps the columns until its script moves one in
 # (4,096 map units west of the centre), and an absent totem stays.
 TOTEM_PARKED_XY = (-4096 * mjcf.MAP_UNIT, 0.0)
-ITEMS = tuple(mjcf.floor_thing(f"item_{k}", "cylinder", 31, 17, ITEM_RED, glow=palette.ARMOUR_PART_GLOW)
+ITEMS = tuple(mjcf.sprite_thing(f"item_{k}", sprites.GREEN_ARMOUR if k % 2 == 0 else sprites.BLUE_ARMOUR)
               for k in range(POOL_SIZE))
 TOTEM_COLOURS = (tuple(RED), tuple(GREEN))  # by totem_green
-ITEM_COLOURS = tuple(tuple(ITEM_GREEN if k % 2 == 0 else ITEM_RED) for k in range(POOL_SIZE))
 
 
 class TwoColour(core.MazeRules):
@@ -178,9 +178,7 @@ class TwoColour(core.MazeRules):
         totem_xy = config["object_xy"][:, 0]
         spawn_xy = config["spawn_xy"]
         totem_green = rules.uniform(xp, keys, rules.DRAW_COLOUR) < 0.5
-        rgba = rules.constant(xp, TOTEM_COLOURS, xp.float64, device)
-        # Items alternate colours, green first; the totem's is drawn per episode.
-        item_rgba = xp.broadcast_to(rules.constant(xp, ITEM_COLOURS, xp.float64, device)[None], (batch, POOL_SIZE, 4))
+        rgba = rules.constant(xp, TOTEM_COLOURS, xp.float64, device)  # the totem's colour is drawn per episode
         # An imported layout may spawn the agent on the totem's spot: the
         # released script's SetActorPosition then fails and both columns stay
         # parked outside the map, so the episode has no totem (measured in ViZDoom).
@@ -190,7 +188,7 @@ class TwoColour(core.MazeRules):
             "pose": xp.concat([spawn_xy, xp.zeros((batch, 1), dtype=xp.float64, device=device)], axis=1),
             "object_xy": xp.concat([totem_xy[:, None], xp.zeros((batch, POOL_SIZE, 2), dtype=xp.float64, device=device)], axis=1),
             "object_shown": xp.concat([~no_totem[:, None], xp.zeros((batch, POOL_SIZE), dtype=xp.bool, device=device)], axis=1),
-            "object_rgba": xp.concat([rgba[xp.astype(totem_green, xp.int64)][:, None], item_rgba], axis=1),
+            "object_rgba": rgba[xp.astype(totem_green, xp.int64)][:, None],  # the totem's (object 0) only
             "walls": config["walls"],
             "totem_green": totem_green,
             "health": xp.full(batch, START_HEALTH, dtype=xp.int64, device=device),
@@ -340,7 +338,7 @@ class TwoColour(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="two_colour",
     task=TwoColour,
-    gym_id="mjmaze/TwoColour-v6",
+    gym_id="mjmaze/TwoColour-v7",
     seed_code=4,
     difficulty="complexity",
     difficulties=COMPLEXITIES,

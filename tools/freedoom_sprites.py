@@ -1,0 +1,81 @@
+"""Builds ``mjmaze/freedoom/sprites.wad``: the released items' pictures from Freedoom 0.10.1, unchanged.
+
+    python tools/freedoom_sprites.py           # rebuild it from the paper's freedoom2.wad (fetched once)
+    python tools/freedoom_sprites.py --check   # does the shipped file hold exactly those lumps?
+    python tools/freedoom_sprites.py --figure docs/sprites.png  # the pictures beside what mjmaze draws
+
+The paper's agents saw Freedoom 0.10.1 (``tools/paper_agents_vizdoom.py``
+fetches its ``freedoom2.wad`` and checks it). mjmaze ships only the pictures
+of the eight things the released generators place as items, every frame of
+their animations (:data:`mjmaze.sprites.SPRITES`), and the palette, copied
+byte for byte into a small PWAD, with Freedoom's licence beside it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import pathlib
+import sys
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+
+from mjmaze import files, sprites  # noqa: E402
+
+TARGET = pathlib.Path(__file__).resolve().parent.parent / "mjmaze" / "freedoom" / sprites.SPRITE_WAD
+
+
+def wanted_lumps(source: dict[str, bytes]) -> dict[str, bytes]:
+    """The palette, then every frame of every item sprite, from ``source``'s lumps."""
+    names = ["PLAYPAL"] + [f"{s.name}{frame}0" for s in sprites.SPRITES for frame in dict.fromkeys(f for f, _, _ in s.frames)]
+    missing = [name for name in names if name not in source]
+    if missing:
+        raise SystemExit(f"error: the source wad lacks {missing}")
+    return {name: source[name][:768] if name == "PLAYPAL" else source[name] for name in names}
+
+
+def figure(path: pathlib.Path) -> None:
+    """Each sprite's frames as Freedoom draws them, then mjmaze's picture (its average before Doom's light), 4x."""
+    import numpy as np
+    from PIL import Image
+
+    rows = []
+    for sprite in sprites.SPRITES:
+        tiles = []
+        for frame in dict.fromkeys(f for f, _, _ in sprite.frames):
+            rgb, opaque, _ = sprites.picture(f"{sprite.name}{frame}0")
+            tiles.append(np.where(opaque[..., None], rgb, 40))
+        texels, brightness, opaque, _ = sprites.texture(sprite)
+        drawn = np.minimum(texels * brightness / sprites.palette.AMBIENT * 0.5, 255).astype(np.uint8)
+        tiles.append(np.where(opaque[..., None], drawn, 40))
+        height = max(t.shape[0] for t in tiles)
+        row = np.concatenate([np.pad(t, ((0, height - t.shape[0]), (0, 4), (0, 0)), constant_values=0) for t in tiles], 1)
+        rows.append(row)
+    width = max(r.shape[1] for r in rows)
+    image = np.concatenate([np.pad(r, ((0, 4), (0, width - r.shape[1]), (0, 0))) for r in rows])
+    Image.fromarray(image.astype(np.uint8)).resize((image.shape[1] * 4, image.shape[0] * 4), Image.NEAREST).save(path)
+    print(f"wrote {path}")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--check", action="store_true", help="compare the shipped file with the source instead of writing it")
+    parser.add_argument("--figure", type=pathlib.Path, help="draw the pictures into this PNG instead")
+    parser.add_argument("--freedoom", default="paper", metavar="paper|PATH", help="the source freedoom2.wad")
+    args = parser.parse_args()
+    if args.figure:
+        figure(args.figure)
+        return
+    import paper_agents_vizdoom
+
+    source = paper_agents_vizdoom.freedoom_path(args.freedoom)
+    data = sprites.write_wad(wanted_lumps(sprites.read_wad(pathlib.Path(source).read_bytes())))
+    if args.check:
+        same = TARGET.exists() and TARGET.read_bytes() == data
+        print(f"{TARGET}: {'the same as' if same else 'DIFFERS from'} the pictures in {source}")
+        raise SystemExit(0 if same else 1)
+    files.atomic_write_bytes(TARGET, data)
+    print(f"wrote {TARGET} ({len(data)} bytes) from {source}")
+
+
+if __name__ == "__main__":
+    main()
