@@ -10,10 +10,12 @@ measured in ViZDoom (docs/look.md).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
+import mujoco
 import numpy as np
 
-from mjmaze import mjcf, palette, rules, walls
+from mjmaze import mjcf, palette, rules, sprites, walls
 
 # Head-bob: Doom's P_CalcHeight and P_BobWeapon. Walking swings the eye by half
 # the "bob", min(v^2 / 4, 16) map units with v the speed after the tic's thrust
@@ -99,6 +101,61 @@ def draw_pistol(xp, frames, dx, dy) -> None:
         in_cols = (cols >= cols_box.start + dx[:, None]) & (cols < cols_box.stop + dx[:, None])  # (B, W)
         inside = in_rows[:, :, None, None] & in_cols[:, None, :, None]
         frames[...] = xp.where(inside, rules.constant(xp, colour, xp.uint8, dev), frames)
+
+
+class SpriteView:
+    """Doom's sprites in a frame: each item's picture turned to face the camera, at its animation
+    frame, averaged as the released frames average it at its depth (:func:`mjmaze.sprites.textures`).
+
+    Made once per model (its sprite geoms, :func:`mjmaze.mjcf.sprite_geoms`)
+    and frame width, on numpy or torch (``xp``, as :mod:`mjmaze.rules`); call
+    it before each render with a batch of worlds.
+    """
+
+    def __init__(self, xp, device, model: mujoco.MjModel, objects: Sequence[mjcf.ObjectGeom], width: int):
+        self._xp = xp
+        geoms = mjcf.sprite_geoms(model, objects)
+        #: ``(n,)`` int64 numpy: the geoms this view turns and pictures.
+        self.geom_ids = geoms
+        names = [model.geom(int(g)).name for g in geoms]
+        rows = [next(k for k, obj in enumerate(objects) if obj.name == name) for name in names]
+        kinds = list(dict.fromkeys(objects[k].sprite for k in rows))
+        # Every kind's animation repeats within the least common multiple of their cycles.
+        self._cycle = math.lcm(*(sum(t for _, t, _ in kind.frames) for kind in kinds)) if kinds else 1
+        levels = sprites.MIP_LEVELS
+        table = np.zeros((max(len(kinds), 1), self._cycle, levels), dtype=np.int64)  # (kind, tic, level) -> material
+        for k, kind in enumerate(kinds):
+            frames = sprites.frame_of_tic(kind, self._cycle)
+            for level in range(levels):
+                ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MATERIAL, mjcf.sprite_material(kind, f, level))
+                       for f in range(len(kind.frames))]
+                table[k, :, level] = np.array(ids)[frames]
+        self._materials = xp.asarray(table.reshape(-1), device=device)
+        self._kind = xp.asarray(np.array([kinds.index(objects[k].sprite) for k in rows], dtype=np.int64), device=device)
+        self._rows = xp.asarray(np.array(rows, dtype=np.int64), device=device)
+        # A frame pixel spans depth / (focal length in pixels) metres, each sprite pixel a map unit.
+        self._pixels_per_texel = mjcf.DOOM_FOCAL_ACROSS * width * mjcf.MAP_UNIT
+
+    def __len__(self) -> int:
+        return len(self.geom_ids)
+
+    def __call__(self, tics, eye_xy, yaw, object_xy):
+        """``(geom_matid (B, n), geom_quat (B, 4))`` of the sprite geoms in worlds at level tic ``tics``
+        ``(B,)`` int, the camera at ``eye_xy`` ``(B, 2)`` heading ``yaw`` ``(B,)``, objects at ``object_xy``
+        ``(B, objects, 2)``."""
+        xp = self._xp
+        half = yaw / 2
+        zero = xp.zeros_like(half)
+        quat = xp.stack([xp.cos(half), zero, zero, xp.sin(half)], axis=-1)  # turned to the camera's heading
+        offset = xp.take(object_xy, self._rows, axis=1) - eye_xy[:, None, :]
+        depth = offset[..., 0] * xp.cos(yaw)[:, None] + offset[..., 1] * xp.sin(yaw)[:, None]
+        # The level whose blocks are about a frame pixel: log2(texels per pixel), rounded.
+        texels = xp.where(depth > 0, depth, 1e-3) / self._pixels_per_texel
+        level = xp.astype(xp.floor(xp.log2(xp.where(texels > 1, texels, 1.0)) + 0.5), xp.int64)
+        level = rules.at_most(xp, level, sprites.MIP_LEVELS - 1)
+        tic = xp.astype(tics, xp.int64)[:, None] % self._cycle
+        index = (self._kind[None, :] * self._cycle + tic) * sprites.MIP_LEVELS + level
+        return xp.reshape(xp.take(self._materials, xp.reshape(index, (-1,)), axis=0), index.shape), quat
 
 
 def tint(xp, frames, rgb, alpha):

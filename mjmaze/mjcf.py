@@ -60,7 +60,7 @@ class ObjectGeom:
     ``sprite`` (textured style only): Doom's picture of the thing
     (:mod:`mjmaze.sprites`), drawn on a flat mesh in the thing's spot that the
     renderers turn to face the camera every frame, as Doom draws a sprite (a
-    world geom's ``geom_quat``: :func:`face_camera`); ``type``, ``size`` and
+    world geom's ``geom_quat`` and material: :class:`mjmaze.look.SpriteView`); ``type``, ``size`` and
     ``rgba`` then serve the flat style and maps, which show the sprite's mean
     colour on a cylinder. A sprite object cannot collide.
 
@@ -105,21 +105,8 @@ def floor_thing(name: str, shape: str, width: float, height: float, rgba, collid
 def sprite_thing(name: str, sprite: sprites.Sprite) -> ObjectGeom:
     """A Doom item lying on the floor drawn as its ``sprite``; a cylinder of the
     picture's width and height in its mean colour in the flat style and maps."""
-    texels = sprites.texture(sprite)[0]
-    return floor_thing(name, "cylinder", texels.shape[1], texels.shape[0], (*sprites.mean_colour(sprite), 1.0),
-                       sprite=sprite)
-
-
-def face_camera(xp, yaw):
-    """The ``geom_quat`` ``(B, 4)`` that turns a sprite's geom to face cameras of headings ``yaw`` ``(B,)`` (radians).
-
-    Doom draws a sprite in the view plane, whatever the angle to it: the
-    picture's plane turns with the camera's heading (numpy or torch, as
-    :mod:`mjmaze.rules`).
-    """
-    half = yaw / 2
-    zero = xp.zeros_like(half)
-    return xp.stack([xp.cos(half), zero, zero, xp.sin(half)], axis=-1)
+    height, width = sprites.shape(sprite)[0].shape
+    return floor_thing(name, "cylinder", width, height, (*sprites.mean_colour(sprite), 1.0), sprite=sprite)
 
 
 def template_path(name: str = "arena.xml"):
@@ -322,14 +309,20 @@ def _sprite_asset(sprite: sprites.Sprite) -> str:
     return f"sprite_{sprite.name}"
 
 
-def _add_sprite(asset: ET.Element, obj: ObjectGeom) -> tuple[dict, tuple]:
-    """The mesh, texture and material of ``obj``'s sprite (once per sprite); ``(geom attributes, rgba)``.
+def sprite_material(sprite: sprites.Sprite, frame: int, level: int) -> str:
+    """The material (and texture) of ``sprite``'s animation frame ``frame`` at mip level ``level``."""
+    return f"{_sprite_asset(sprite)}_{frame}_{level}"
 
-    GL draws a texel ``texel x rgba x (AMBIENT + emission)`` before Doom's
-    light: white texels at the picture's brightness (:func:`mjmaze.sprites.texture`).
+
+def _add_sprite(asset: ET.Element, obj: ObjectGeom) -> tuple[dict, tuple]:
+    """The mesh, textures and materials of ``obj``'s sprite (once per sprite); ``(geom attributes, rgba)``.
+
+    A texture and a material per animation frame and mip level
+    (:func:`mjmaze.sprites.textures`); GL draws a texel ``texel x (AMBIENT +
+    emission)`` before Doom's light, the geom's colour white.
     """
     name = _sprite_asset(obj.sprite)
-    texels, brightness, _, _ = sprites.texture(obj.sprite)
+    texels, emission = sprites.textures(obj.sprite)
     if asset.find(f"mesh[@name='{name}']") is None:
         # Compiled from the quads nudged apart (the compiler merges no vertex
         # and finds a volume), recentred by it: write_sprites writes them as they are.
@@ -340,12 +333,15 @@ def _add_sprite(asset: ET.Element, obj: ObjectGeom) -> tuple[dict, tuple]:
                       vertex=" ".join(f"{v:.5f}" for v in verts.ravel()),
                       face=" ".join(map(str, faces.ravel())),
                       texcoord=" ".join(f"{v:.5f}" for v in texcoords.ravel()))
-        ET.SubElement(asset, "texture", name=name, type="2d", builtin="flat",
-                      width=str(texels.shape[1]), height=str(texels.shape[0]), rgb1="1 1 1")
-        ET.SubElement(asset, "material", name=name, texture=name, emission=f"{max(0.0, brightness - palette.AMBIENT):.4f}",
-                      specular="0", shininess="0", reflectance="0")
-    grey = min(1.0, brightness / palette.AMBIENT)
-    return dict(name=obj.name, type="mesh", mesh=name, material=name), (grey, grey, grey, 1.0)
+        for frame in range(texels.shape[0]):
+            for level in range(texels.shape[1]):
+                material = sprite_material(obj.sprite, frame, level)
+                ET.SubElement(asset, "texture", name=material, type="2d", builtin="flat",
+                              width=str(texels.shape[3]), height=str(texels.shape[2]), rgb1="1 1 1")
+                ET.SubElement(asset, "material", name=material, texture=material, emission=f"{emission[frame]:.4f}",
+                              specular="0", shininess="0", reflectance="0")
+    return (dict(name=obj.name, type="mesh", mesh=name, material=sprite_material(obj.sprite, 0, 0)),
+            (1.0, 1.0, 1.0, 1.0))
 
 
 def write_sprites(model: mujoco.MjModel, objects: Sequence[ObjectGeom]) -> None:
@@ -353,34 +349,37 @@ def write_sprites(model: mujoco.MjModel, objects: Sequence[ObjectGeom]) -> None:
 
     A mesh's vertices are written as :func:`mjmaze.sprites.mesh_quads` gives
     them, in the frame of a geom at the object's height (``z``), unrotated
-    until :func:`face_camera` turns it: the compiler's recentring is undone.
+    until :class:`mjmaze.look.SpriteView` turns it: the compiler's recentring
+    is undone.
     """
-    for obj in objects:
-        if obj.sprite is None:
+    written = set()
+    for geom in sprite_geoms(model, objects):
+        obj = next(obj for obj in objects if obj.name == model.geom(int(geom)).name)
+        model.geom_pos[geom, 2] = obj.z
+        model.geom_quat[geom] = (1.0, 0.0, 0.0, 0.0)
+        model.geom_rbound[geom] = 0.0  # 0 = never culled by bounding sphere
+        if obj.sprite in written:
             continue
-        name = _sprite_asset(obj.sprite)
-        mesh = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MESH, name)
-        geom = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, obj.name)
-        if mesh < 0 or model.geom_dataid[geom] != mesh:
-            continue  # the flat style: a cylinder
-        _paint(model, name, sprites.texture(obj.sprite)[0])
+        written.add(obj.sprite)
+        texels, _ = sprites.textures(obj.sprite)
+        for frame in range(texels.shape[0]):
+            for level in range(texels.shape[1]):
+                _paint(model, sprite_material(obj.sprite, frame, level), texels[frame, level])
+        mesh = model.geom_dataid[geom]
         verts, texcoords = sprites.mesh_quads(obj.sprite, obj.z, MAP_UNIT)
         verts, texcoords = verts.reshape(-1, 3), texcoords.reshape(-1, 2)
         if model.mesh_vertnum[mesh] != len(verts) or model.mesh_texcoordnum[mesh] != len(texcoords):
-            raise RuntimeError(f"the compiled mesh {name} is not its quads: vertices were merged")
+            raise RuntimeError(f"the compiled mesh {_sprite_asset(obj.sprite)} is not its quads: vertices were merged")
         faces = (np.array([(0, 1, 2), (0, 2, 3)])[None] + (np.arange(len(verts) // 4) * 4)[:, None, None]).reshape(-1, 3)
         vert_adr, face_adr = model.mesh_vertadr[mesh], model.mesh_faceadr[mesh]
         model.mesh_vert[vert_adr : vert_adr + len(verts)] = verts
         model.mesh_face[face_adr : face_adr + len(faces)] = faces
         normal_adr = model.mesh_normaladr[mesh]
-        model.mesh_normal[normal_adr : normal_adr + model.mesh_normalnum[mesh]] = (-1.0, 0.0, 0.0)
+        model.mesh_normal[normal_adr : normal_adr + model.mesh_normalnum[mesh]] = (-1.0, 0.0, 0.0)  # toward the camera
         model.mesh_facenormal[face_adr : face_adr + len(faces)] = 0
         texcoord_adr = model.mesh_texcoordadr[mesh]
         model.mesh_texcoord[texcoord_adr : texcoord_adr + len(texcoords)] = texcoords
         model.mesh_facetexcoord[face_adr : face_adr + len(faces)] = faces
-        model.geom_pos[geom, 2] = obj.z
-        model.geom_quat[geom] = (1.0, 0.0, 0.0, 0.0)
-        model.geom_rbound[geom] = 0.0  # 0 = never culled by bounding sphere
 
 
 def sprite_geoms(model: mujoco.MjModel, objects: Sequence[ObjectGeom]) -> np.ndarray:

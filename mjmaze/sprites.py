@@ -26,6 +26,8 @@ import numpy as np
 from mjmaze import palette
 
 SPRITE_WAD = "sprites.wad"
+#: Pictures per animation frame: the picture averaged over blocks of 1, 2, 4, 8 pixels (:func:`textures`).
+MIP_LEVELS = 4
 
 
 @dataclasses.dataclass(frozen=True)
@@ -109,43 +111,84 @@ def picture(name: str) -> tuple[np.ndarray, np.ndarray, tuple[int, int]]:
     return decode_patch(lumps[name], lumps["PLAYPAL"])
 
 
-@functools.lru_cache(maxsize=None)
-def texture(sprite: Sprite) -> tuple[np.ndarray, float, np.ndarray, tuple[int, int]]:
-    """What mjmaze draws of ``sprite``: ``(texels (h, w, 3) uint8, brightness, opaque (h, w), offsets)``.
-
-    Each pixel is its colours' average over the animation (weighted by tics)
-    as GL must draw them before Doom's light (:class:`mjmaze.look.DoomLight`):
-    a sector-lit frame's palette colour times :data:`mjmaze.palette.SPRITE_LIT`,
-    a fullbright one's times :data:`mjmaze.palette.SPRITE_FULLBRIGHT`. The
-    texels are that relative to its brightest channel, ``brightness`` (GL's
-    colour of a white texel); transparent texels take the mean colour (only
-    the mesh's edges could sample them).
-    """
-    total, weight, shape = 0.0, 0.0, None
-    opaque_any = None
-    for frame, tics, bright in sprite.frames:
-        rgb, opaque, offsets = picture(f"{sprite.name}{frame}0")
-        if shape is None:
-            shape, first_offsets, opaque_any = rgb.shape, offsets, np.zeros(opaque.shape, dtype=bool)
-        elif rgb.shape != shape or offsets != first_offsets:
+def shape(sprite: Sprite) -> tuple[np.ndarray, tuple[int, int]]:
+    """``(opaque (h, w), (left, top) offsets)``: where any of ``sprite``'s frames is drawn, and its origin."""
+    opaque_any, first = None, None
+    for letter, _, _ in sprite.frames:
+        rgb, opaque, offsets = picture(f"{sprite.name}{letter}0")
+        if first is None:
+            opaque_any, first = opaque.copy(), offsets
+        elif opaque.shape != opaque_any.shape or offsets != first:
             raise ValueError(f"{sprite.name}: its frames differ in size or offsets")
-        gain = palette.SPRITE_FULLBRIGHT if bright else palette.SPRITE_LIT
-        total = total + tics * gain * opaque[..., None] * (rgb / 255.0)
-        weight = weight + tics * opaque[..., None]
         opaque_any |= opaque
-    colour = total / np.maximum(weight, 1)
-    colour[~opaque_any] = colour[opaque_any].mean(axis=0)
-    brightness = float(colour.max())
-    texels = np.round(colour / brightness * 255).astype(np.uint8)
-    return texels, brightness, opaque_any, first_offsets
+    return opaque_any, first
+
+
+def _unlit(sprite: Sprite, frame: int) -> np.ndarray:
+    """Frame ``frame``'s colours (0-1) as GL must draw them before Doom's light (see :func:`textures`)."""
+    letter, _, bright = sprite.frames[frame]
+    rgb, _, _ = picture(f"{sprite.name}{letter}0")
+    return rgb / 255.0 * (palette.SPRITE_FULLBRIGHT if bright else palette.SPRITE_LIT)
+
+
+def _block_mean(colour: np.ndarray, opaque: np.ndarray, block: int) -> np.ndarray:
+    """``colour`` averaged over its opaque pixels in blocks of ``block`` x ``block`` pixels, at full size."""
+    height, width, _ = colour.shape
+    rows, cols = -(-height // block) * block, -(-width // block) * block
+    weight = np.zeros((rows, cols))
+    weight[:height, :width] = opaque
+    total = np.zeros((rows, cols, 3))
+    total[:height, :width] = colour * opaque[..., None]
+    pooled = total.reshape(rows // block, block, cols // block, block, 3).sum(axis=(1, 3))
+    count = weight.reshape(rows // block, block, cols // block, block).sum(axis=(1, 3))
+    mean = pooled / np.maximum(count, 1)[..., None]
+    return np.repeat(np.repeat(mean, block, axis=0), block, axis=1)[:height, :width]
+
+
+@functools.lru_cache(maxsize=None)
+def textures(sprite: Sprite) -> tuple[np.ndarray, np.ndarray]:
+    """What mjmaze draws of ``sprite``: ``(texels (frames, MIP_LEVELS, h, w, 3) uint8, emission (frames,))``.
+
+    Per animation frame, its colours as GL must draw them before Doom's light
+    (:class:`mjmaze.look.DoomLight`): a sector-lit frame's palette colours
+    times :data:`mjmaze.palette.SPRITE_LIT`, a fullbright one's times
+    :data:`mjmaze.palette.SPRITE_FULLBRIGHT`. GL draws a texel ``texel x
+    (AMBIENT + emission)``: texels are the colours over ``AMBIENT + emission``,
+    the emission what the brightest channel needs beyond ``AMBIENT``.
+
+    Level ``k`` of a frame is the picture averaged over blocks of ``2**k``
+    pixels (its opaque ones), as the released frames average a sprite that
+    320x180 pixels drew into 112x64 (``cv2.INTER_AREA``): :class:`SpriteView`
+    shows the level of each sprite's depth. Transparent texels take the
+    frame's mean colour (only the mesh's edges could sample them).
+    """
+    opaque, _ = shape(sprite)
+    texels, emission = [], []
+    for frame in range(len(sprite.frames)):
+        colour = _unlit(sprite, frame)
+        colour[~opaque] = colour[opaque].mean(axis=0)
+        white = max(float(colour.max()), palette.AMBIENT)
+        emission.append(white - palette.AMBIENT)
+        levels = [_block_mean(colour, opaque, 2**level) for level in range(MIP_LEVELS)]
+        texels.append(np.round(np.stack(levels) / white * 255).astype(np.uint8))
+    return np.stack(texels), np.array(emission)
 
 
 def mean_colour(sprite: Sprite) -> tuple[float, float, float]:
-    """The mean (0-1) of ``sprite``'s drawn pixels before Doom's light, over :data:`mjmaze.palette.AMBIENT`:
-    the one colour a cylinder or a map shows it in (GL draws a colour ``c`` as ``c x AMBIENT``)."""
-    texels, brightness, opaque, _ = texture(sprite)
-    mean = texels[opaque].mean(axis=0) / 255 * brightness / palette.AMBIENT
-    return tuple(float(v) for v in np.minimum(mean, 1.0).round(3))
+    """The mean (0-1) of ``sprite``'s drawn pixels over its animation (weighted by tics), before Doom's
+    light, over :data:`mjmaze.palette.AMBIENT`: the one colour a cylinder or a map shows it in (GL
+    draws a colour ``c`` as ``c x AMBIENT``)."""
+    opaque, _ = shape(sprite)
+    tics = np.array([t for _, t, _ in sprite.frames], dtype=float)
+    mean = sum(t * _unlit(sprite, f)[opaque].mean(axis=0) for f, t in enumerate(tics)) / tics.sum()
+    return tuple(float(v) for v in np.minimum(mean / palette.AMBIENT, 1.0).round(3))
+
+
+def frame_of_tic(sprite: Sprite, tics: int) -> np.ndarray:
+    """``(tics,)`` int: the animation frame Doom shows at each level tic (every thing starts its
+    animation at the level's start, tic 0, as the released maps place them)."""
+    sequence = np.concatenate([np.full(t, f) for f, (_, t, _) in enumerate(sprite.frames)])
+    return sequence[np.arange(tics) % len(sequence)]
 
 
 def mesh_quads(sprite: Sprite, z_centre: float, unit: float) -> tuple[np.ndarray, np.ndarray]:
@@ -159,7 +202,7 @@ def mesh_quads(sprite: Sprite, z_centre: float, unit: float) -> tuple[np.ndarray
     ``-x`` (bottom left, bottom right, top right, top left); texture
     coordinates with ``v = 0`` at the picture's top row.
     """
-    _, _, opaque, (left, top) = texture(sprite)
+    opaque, (left, top) = shape(sprite)
     height, width = opaque.shape
     verts, coords = [], []
     for row in range(height):

@@ -167,7 +167,8 @@ class MazeBatchEnv(batch.BatchEnv):
         self._wall_visual = geom("walls_visual")
         self._object_ids = torch.tensor([geom(obj.name) for obj in task.objects], dtype=torch.long, device=dev)
         self._object_z = torch.tensor([obj.z for obj in task.objects], dtype=torch.float32, device=dev)
-        self._sprite_ids = torch.as_tensor(mjcf.sprite_geoms(mjm, task.objects), device=dev)
+        self._sprites = look.SpriteView(self.xp, dev, mjm, task.objects, width) if task.visual_style == "textured" else None
+        self._sprite_ids = torch.as_tensor(self._sprites.geom_ids if self._sprites else [], dtype=torch.long, device=dev)
         colliding = [k for k, obj in enumerate(task.objects) if obj.collides]
         self._colliding = torch.tensor(colliding, dtype=torch.long, device=dev)
         self._collision_ids = torch.tensor(
@@ -179,7 +180,7 @@ class MazeBatchEnv(batch.BatchEnv):
         textured = task.visual_style == "textured"
         with wp.ScopedDevice(self._wp_device):
             batched = ({"geom_pos": n, "geom_rgba": n, "geom_dataid": n} | ({"cam_pos": n} if task.head_bob else {})
-                       | ({"geom_quat": n} if len(self._sprite_ids) else {}))
+                       | ({"geom_quat": n, "geom_matid": n} if len(self._sprite_ids) else {}))
             self._model = mjw.put_model(mjm, batch_sizes=batched)
             self._data = mjw.put_data(mjm, mujoco.MjData(mjm), nworld=n, nconmax=_CONTACTS_PER_WORLD, njmax=_CONTACTS_PER_WORLD)
             self._render = mjw.create_render_context(
@@ -196,6 +197,7 @@ class MazeBatchEnv(batch.BatchEnv):
         self._geom_pos = wp.to_torch(self._model.geom_pos)
         self._geom_rgba = wp.to_torch(self._model.geom_rgba)
         self._geom_quat = wp.to_torch(self._model.geom_quat)  # per world with sprites
+        self._geom_matid = wp.to_torch(self._model.geom_matid)  # per world with sprites
         self._geom_dataid = wp.to_torch(self._model.geom_dataid)
         self._cam_pos = wp.to_torch(self._model.cam_pos)  # per world with head-bob
         self._camera = mujoco.mj_name2id(mjm, mujoco.mjtObj.mjOBJ_CAMERA, mjcf.EGO_CAMERA)
@@ -368,8 +370,11 @@ class MazeBatchEnv(batch.BatchEnv):
         if task.head_bob:
             eye_dz, pistol_dx, pistol_dy = look.view_bob(self.xp, self._bob, self.state["steps"] * core.TICS_PER_STEP)
             self._cam_pos[:, self._camera, 2] = (mjcf.EYE_HEIGHT + eye_dz).float()
-        if len(self._sprite_ids):
-            self._geom_quat[:, self._sprite_ids] = mjcf.face_camera(torch, self._qpos[:, 2:3]).float()
+        if len(self._sprite_ids):  # Doom's sprites: facing the camera, at their animation frame and depth
+            tics = look.EPISODE_START_TIC + self.state["steps"] * core.TICS_PER_STEP
+            materials, quat = self._sprites(tics, self._qpos[:, 0:2], self._qpos[:, 2], self.state["object_xy"])
+            self._geom_matid[:, self._sprite_ids] = materials.int()
+            self._geom_quat[:, self._sprite_ids] = quat[:, None, :].float()
         mjw.kinematics(m, d)  # positions lag a step behind mjw.step's integration
         mjw.camlight(m, d)
         mjw.refit_bvh(m, d, rc)

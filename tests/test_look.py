@@ -137,14 +137,22 @@ def test_floor_and_ceiling_have_vizdooms_colours(room, floor, ceiling):
     env.task.close()
 
 
-def object_colour(env, name, pose):
-    """Mean colour where object ``name`` is drawn, seen from ``pose``, outside the pistol."""
-    frame = frame_at(env, *pose)
-    mask = np.isin(env.task.segmentation(env.physics), env.physics.object_ids([name])[1])
-    rows, cols, _ = look.pistol_pixels(frame.shape[1], frame.shape[0])
-    mask[rows, cols] = False
-    assert mask.sum() >= 10
-    return frame[mask].mean(axis=0)
+def object_colour(env, name, pose, animation_steps=1):
+    """Mean colour where object ``name`` is drawn, seen from ``pose``, outside the pistol, over the
+    frames of the episode's first ``animation_steps`` steps (a sprite's animation: ViZDoom's measurements
+    average the blink)."""
+    task, row = env.task, env.task.row
+    colours = []
+    for step in range(animation_steps):
+        task.state["steps"][row] = step
+        frame = frame_at(env, *pose)
+        mask = np.isin(task.segmentation(env.physics), env.physics.object_ids([name])[1])
+        rows, cols, _ = look.pistol_pixels(frame.shape[1], frame.shape[0])
+        mask[rows, cols] = False
+        assert mask.sum() >= 10
+        colours.append(frame[mask].mean(axis=0))
+    task.state["steps"][row] = 0
+    return np.mean(colours, axis=0)
 
 
 # ViZDoom with the paper's Freedoom 0.10.1: each released item 1 m ahead and
@@ -179,7 +187,7 @@ def stone_room_with(sprite):
 def test_each_item_is_freedoom_0_10_1s_picture_as_bright_as_vizdoom_draws_it(sprite):
     env = stone_room_with(sprite)
     env.physics.place_objects(env.physics.object_ids(["item_0"])[0], np.array([[1.0, 0.3]]))
-    colour = object_colour(env, "item_0", (0.0, 0.0, 0.0))
+    colour = object_colour(env, "item_0", (0.0, 0.0, 0.0), animation_steps=45)  # every kind's whole cycle
     env.task.close()
     doom = np.array(ITEMS_1M_AHEAD[sprite])
     # Within 20% and a few levels: GL samples the picture's nearest pixel where

@@ -34,7 +34,7 @@ def wanted_lumps(source: dict[str, bytes]) -> dict[str, bytes]:
 
 
 def figure(path: pathlib.Path) -> None:
-    """Each sprite's frames as Freedoom draws them, then mjmaze's picture (its average before Doom's light), 4x."""
+    """Each sprite's frames as Freedoom draws them, then mjmaze's first frame averaged over 2, 4, 8 pixels, 4x."""
     import numpy as np
     from PIL import Image
 
@@ -44,9 +44,10 @@ def figure(path: pathlib.Path) -> None:
         for frame in dict.fromkeys(f for f, _, _ in sprite.frames):
             rgb, opaque, _ = sprites.picture(f"{sprite.name}{frame}0")
             tiles.append(np.where(opaque[..., None], rgb, 40))
-        texels, brightness, opaque, _ = sprites.texture(sprite)
-        drawn = np.minimum(texels * brightness / sprites.palette.AMBIENT * 0.5, 255).astype(np.uint8)
-        tiles.append(np.where(opaque[..., None], drawn, 40))
+        texels, emission = sprites.textures(sprite)
+        opaque, _ = sprites.shape(sprite)
+        for level in range(1, sprites.MIP_LEVELS):  # frame A averaged over 2, 4, 8 pixels
+            tiles.append(np.where(opaque[..., None], texels[0, level], 40))
         height = max(t.shape[0] for t in tiles)
         row = np.concatenate([np.pad(t, ((0, height - t.shape[0]), (0, 4), (0, 0)), constant_values=0) for t in tiles], 1)
         rows.append(row)

@@ -94,7 +94,7 @@ class MazeTask(core.MazeRules, base.Task):
         self.horizontal_fov = mjcf.EGO_HORIZONTAL_FOV
         self._config_in_model = None
         self._object_ids = physics.object_ids([geom.name for geom in self.objects])[1]
-        self._sprite_ids = mjcf.sprite_geoms(model, self.objects)
+        self._sprites = look.SpriteView(np, "cpu", model, self.objects, self.width) if textured else None
 
     def initialize_episode(self, physics: MazePhysics) -> None:
         self._bind(physics)
@@ -203,9 +203,12 @@ class MazeTask(core.MazeRules, base.Task):
         return self._renderer.segmentation(self._bound_data)
 
     def _face_sprites(self) -> None:
-        """Turns the sprites to face the camera (:func:`mjmaze.mjcf.face_camera`)."""
-        if len(self._sprite_ids):
-            self._model.geom_quat[self._sprite_ids] = mjcf.face_camera(np, self._qpos[2:3])
+        """Turns the sprites to the camera, at their animation frame and depth (:class:`mjmaze.look.SpriteView`)."""
+        if self._sprites is not None and len(self._sprites):
+            tics = np.array([look.EPISODE_START_TIC + self.steps * TICS_PER_STEP])
+            materials, quat = self._sprites(tics, self._qpos[None, 0:2], self._qpos[2:3], self.state["object_xy"][self.row][None])
+            self._model.geom_matid[self._sprites.geom_ids] = materials[0]
+            self._model.geom_quat[self._sprites.geom_ids] = quat
 
     def _bob_view(self, physics: MazePhysics) -> tuple[int, int]:
         """Puts the eye where head-bob has it now; returns the pistol's shift in pixels (right, down)."""
