@@ -117,9 +117,9 @@ class SpriteView:
         geoms = mjcf.sprite_geoms(model, objects)
         #: ``(n,)`` int64 numpy: the geoms this view turns and pictures.
         self.geom_ids = geoms
-        names = [model.geom(int(g)).name for g in geoms]
-        rows = [next(k for k, obj in enumerate(objects) if obj.name == name) for name in names]
-        kinds = list(dict.fromkeys(objects[k].sprite for k in rows))
+        by_name = {obj.name: obj for obj in objects}
+        of_geom = [by_name[model.geom(int(g)).name].sprite for g in geoms]
+        kinds = list(dict.fromkeys(of_geom))
         # Every kind's animation repeats within the least common multiple of their cycles.
         self._cycle = math.lcm(*(sum(t for _, t, _ in kind.frames) for kind in kinds)) if kinds else 1
         levels = sprites.MIP_LEVELS
@@ -131,23 +131,22 @@ class SpriteView:
                        for f in range(len(kind.frames))]
                 table[k, :, level] = np.array(ids)[frames]
         self._materials = xp.asarray(table.reshape(-1), device=device)
-        self._kind = xp.asarray(np.array([kinds.index(objects[k].sprite) for k in rows], dtype=np.int64), device=device)
-        self._rows = xp.asarray(np.array(rows, dtype=np.int64), device=device)
+        self._kind = xp.asarray(np.array([kinds.index(sprite) for sprite in of_geom], dtype=np.int64), device=device)
         # A frame pixel spans depth / (focal length in pixels) metres, each sprite pixel a map unit.
         self._pixels_per_texel = mjcf.DOOM_FOCAL_ACROSS * width * mjcf.MAP_UNIT
 
     def __len__(self) -> int:
         return len(self.geom_ids)
 
-    def __call__(self, tics, eye_xy, yaw, object_xy):
+    def __call__(self, tics, eye_xy, yaw, sprite_xy):
         """``(geom_matid (B, n), geom_quat (B, 4))`` of the sprite geoms in worlds at level tic ``tics``
-        ``(B,)`` int, the camera at ``eye_xy`` ``(B, 2)`` heading ``yaw`` ``(B,)``, objects at ``object_xy``
-        ``(B, objects, 2)``."""
+        ``(B,)`` int, the camera at ``eye_xy`` ``(B, 2)`` heading ``yaw`` ``(B,)``, the geoms at
+        ``sprite_xy`` ``(B, n, 2)``."""
         xp = self._xp
         half = yaw / 2
         zero = xp.zeros_like(half)
         quat = xp.stack([xp.cos(half), zero, zero, xp.sin(half)], axis=-1)  # turned to the camera's heading
-        offset = xp.take(object_xy, self._rows, axis=1) - eye_xy[:, None, :]
+        offset = sprite_xy - eye_xy[:, None, :]
         depth = offset[..., 0] * xp.cos(yaw)[:, None] + offset[..., 1] * xp.sin(yaw)[:, None]
         # The level whose blocks are about a frame pixel: log2(texels per pixel), rounded.
         texels = xp.where(depth > 0, depth, 1e-3) / self._pixels_per_texel

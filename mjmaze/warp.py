@@ -372,7 +372,7 @@ class MazeBatchEnv(batch.BatchEnv):
             self._cam_pos[:, self._camera, 2] = (mjcf.EYE_HEIGHT + eye_dz).float()
         if len(self._sprite_ids):  # Doom's sprites: facing the camera, at their animation frame and depth
             tics = look.EPISODE_START_TIC + self.state["steps"] * core.TICS_PER_STEP
-            materials, quat = self._sprites(tics, self._qpos[:, 0:2], self._qpos[:, 2], self.state["object_xy"])
+            materials, quat = self._sprites(tics, self._qpos[:, 0:2], self._qpos[:, 2], self._geom_pos[:, self._sprite_ids, 0:2])
             self._geom_matid[:, self._sprite_ids] = materials.int()
             self._geom_quat[:, self._sprite_ids] = quat[:, None, :].float()
         mjw.kinematics(m, d)  # positions lag a step behind mjw.step's integration

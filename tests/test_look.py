@@ -137,13 +137,13 @@ def test_floor_and_ceiling_have_vizdooms_colours(room, floor, ceiling):
     env.task.close()
 
 
-def object_colour(env, name, pose, animation_steps=1):
+def object_colour(env, name, pose, animation_steps=1, first_step=0):
     """Mean colour where object ``name`` is drawn, seen from ``pose``, outside the pistol, over the
-    frames of the episode's first ``animation_steps`` steps (a sprite's animation: ViZDoom's measurements
-    average the blink)."""
+    frames of ``animation_steps`` steps of the episode from ``first_step`` (a sprite's animation:
+    ViZDoom's measurements average the blink)."""
     task, row = env.task, env.task.row
     colours = []
-    for step in range(animation_steps):
+    for step in range(first_step, first_step + animation_steps):
         task.state["steps"][row] = step
         frame = frame_at(env, *pose)
         mask = np.isin(task.segmentation(env.physics), env.physics.object_ids([name])[1])
@@ -190,10 +190,11 @@ def test_each_item_is_freedoom_0_10_1s_picture_as_bright_as_vizdoom_draws_it(spr
     colour = object_colour(env, "item_0", (0.0, 0.0, 0.0), animation_steps=45)  # every kind's whole cycle
     env.task.close()
     doom = np.array(ITEMS_1M_AHEAD[sprite])
-    # Within 20% and a few levels: GL samples the picture's nearest pixel where
-    # the released frames average it, and fullbright pictures are matched
-    # 2.5 m ahead, brighter nearer (palette.SPRITE_FULLBRIGHT).
-    assert np.all(np.abs(colour - doom) <= 0.2 * doom + 6), (colour, doom)
+    # Within 30% and a few levels: fullbright pictures are matched 2.5 m ahead,
+    # brighter nearer (palette.SPRITE_FULLBRIGHT); ViZDoom's means cover 13
+    # tics of a 20-tic (keycards) or 36-tic (soulsphere) animation and only
+    # the pixels a thing covers whole (a keycard is 5 pixels wide here).
+    assert np.all(np.abs(colour - doom) <= 0.3 * doom + 6), (colour, doom)
 
 
 @pytest.mark.parametrize("heading", [0.0, 0.8, 1.6, 2.4, 3.1])
@@ -216,6 +217,46 @@ def test_a_sprite_faces_the_camera_from_every_side(heading):
     green = (pixels[:, 1] > 1.3 * pixels[:, 0]) & (pixels[:, 1] > 1.3 * pixels[:, 2])
     red = (pixels[:, 0] > 1.5 * pixels[:, 1]) & (pixels[:, 0] > 1.5 * pixels[:, 2])
     assert green.sum() >= 4 and red.sum() >= 1  # its green pads and red centre
+
+
+def test_the_armour_blinks_as_dooms_a_sector_lit_picture_then_a_fullbright_one():
+    # ZDoom's GreenArmor: ARM1 A for 6 tics, then B "bright" for 7; the level's
+    # clock starts at tic 10 and an agent step is 4 tics, so steps 0..12 show
+    # every tic of the cycle once.
+    env = stone_room_with(sprites.GREEN_ARMOUR)
+    env.physics.place_objects(env.physics.object_ids(["item_0"])[0], np.array([[1.0, 0.3]]))
+    brightness = np.array([object_colour_at_step(env, step).sum() for step in range(13)])
+    env.task.close()
+    tics = (look.EPISODE_START_TIC + 4 * np.arange(13)) % 13
+    lit, bright = brightness[tics < 6], brightness[tics >= 6]
+    assert np.ptp(lit) < 0.02 * lit.mean() and np.ptp(bright) < 0.02 * bright.mean()  # one picture each
+    assert bright.mean() > 1.3 * lit.mean()
+
+
+def object_colour_at_step(env, step):
+    return object_colour(env, "item_0", (0.0, 0.0, 0.0), first_step=step)
+
+
+@pytest.mark.parametrize("distance, level", [(0.4, 0), (0.6, 1), (1.0, 2), (2.0, 3), (3.0, 3)])
+def test_a_sprite_shows_its_picture_averaged_as_the_released_resize_averages_it(distance, level):
+    # A released 320x180 frame drew a map unit (a sprite pixel) 0.94 / d
+    # pixels wide, then averaged 2.86 of them into each 112x64 pixel: a frame
+    # pixel covers ~3 sprite pixels per metre of depth. mjmaze shows the
+    # picture averaged over blocks of about that many pixels (2^level).
+    env = stone_room_with(sprites.MEDIKIT)
+    physics = env.physics
+    ids = physics.object_ids(["item_0"])
+    physics.place_objects(ids[0], np.array([[distance, 0.3 * distance]]))
+    frame = frame_at(env, 0.0, 0.0, 0.0)
+    drawn = frame[env.task.segmentation(physics) == ids[1][0]]
+    material = physics.model.id2name(physics.model.geom_matid[ids[1][0]], "material")
+    env.task.close()
+    assert material == mjcf.sprite_material(sprites.MEDIKIT, 0, level)
+    texels = sprites.textures(sprites.MEDIKIT)[0][0, level]
+    block = 2**level  # each block of the picture is one colour, its pixels' mean
+    assert (texels[:block, :block] == texels[0, 0]).all()
+    if level == 3:  # far off, the grey case and green cross are averaged into a few colours
+        assert len(np.unique(drawn, axis=0)) <= 8
 
 
 def test_two_colour_items_are_the_green_and_the_red_armour_alternately():

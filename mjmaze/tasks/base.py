@@ -206,9 +206,10 @@ class MazeTask(core.MazeRules, base.Task):
         """Turns the sprites to the camera, at their animation frame and depth (:class:`mjmaze.look.SpriteView`)."""
         if self._sprites is not None and len(self._sprites):
             tics = np.array([look.EPISODE_START_TIC + self.steps * TICS_PER_STEP])
-            materials, quat = self._sprites(tics, self._qpos[None, 0:2], self._qpos[2:3], self.state["object_xy"][self.row][None])
-            self._model.geom_matid[self._sprites.geom_ids] = materials[0]
-            self._model.geom_quat[self._sprites.geom_ids] = quat
+            ids, model = self._sprites.geom_ids, self._model
+            materials, quat = self._sprites(tics, self._qpos[None, 0:2], self._qpos[2:3], model.geom_pos[None, ids, 0:2])
+            model.geom_matid[ids] = materials[0]
+            model.geom_quat[ids] = quat
 
     def _bob_view(self, physics: MazePhysics) -> tuple[int, int]:
         """Puts the eye where head-bob has it now; returns the pistol's shift in pixels (right, down)."""
