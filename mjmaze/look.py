@@ -122,7 +122,7 @@ class SpriteView:
         kinds = list(dict.fromkeys(of_geom))
         # Every kind's animation repeats within the least common multiple of their cycles.
         self._cycle = math.lcm(*(sum(t for _, t, _ in kind.frames) for kind in kinds)) if kinds else 1
-        levels = sprites.MIP_LEVELS
+        levels = len(sprites.BOX_SIZES)
         table = np.zeros((max(len(kinds), 1), self._cycle, levels), dtype=np.int64)  # (kind, tic, level) -> material
         for k, kind in enumerate(kinds):
             frames = sprites.frame_of_tic(kind, self._cycle)
@@ -132,8 +132,11 @@ class SpriteView:
                 table[k, :, level] = np.array(ids)[frames]
         self._materials = xp.asarray(table.reshape(-1), device=device)
         self._kind = xp.asarray(np.array([kinds.index(sprite) for sprite in of_geom], dtype=np.int64), device=device)
-        # A frame pixel spans depth / (focal length in pixels) metres, each sprite pixel a map unit.
+        # A frame pixel spans depth / (focal length in pixels) metres, each sprite pixel a map unit;
+        # the level whose square is nearest (geometrically) to a frame pixel's footprint is shown.
         self._pixels_per_texel = mjcf.DOOM_FOCAL_ACROSS * width * mjcf.MAP_UNIT
+        boxes = np.array(sprites.BOX_SIZES, dtype=np.float64)
+        self._thresholds = [float(t) for t in np.sqrt(boxes[:-1] * boxes[1:])]
 
     def __len__(self) -> int:
         return len(self.geom_ids)
@@ -148,12 +151,12 @@ class SpriteView:
         quat = xp.stack([xp.cos(half), zero, zero, xp.sin(half)], axis=-1)  # turned to the camera's heading
         offset = sprite_xy - eye_xy[:, None, :]
         depth = offset[..., 0] * xp.cos(yaw)[:, None] + offset[..., 1] * xp.sin(yaw)[:, None]
-        # The level whose blocks are about a frame pixel: log2(texels per pixel), rounded.
-        texels = xp.where(depth > 0, depth, 1e-3) / self._pixels_per_texel
-        level = xp.astype(xp.floor(xp.log2(xp.where(texels > 1, texels, 1.0)) + 0.5), xp.int64)
-        level = rules.at_most(xp, level, sprites.MIP_LEVELS - 1)
+        footprint = depth / self._pixels_per_texel  # sprite pixels a frame pixel covers
+        level = xp.zeros(depth.shape, dtype=xp.int64, device=rules.device(depth))
+        for threshold in self._thresholds:
+            level = level + xp.astype(footprint > threshold, xp.int64)
         tic = xp.astype(tics, xp.int64)[:, None] % self._cycle
-        index = (self._kind[None, :] * self._cycle + tic) * sprites.MIP_LEVELS + level
+        index = (self._kind[None, :] * self._cycle + tic) * len(sprites.BOX_SIZES) + level
         return xp.reshape(xp.take(self._materials, xp.reshape(index, (-1,)), axis=0), index.shape), quat
 
 

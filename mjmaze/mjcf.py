@@ -310,14 +310,14 @@ def _sprite_asset(sprite: sprites.Sprite) -> str:
 
 
 def sprite_material(sprite: sprites.Sprite, frame: int, level: int) -> str:
-    """The material (and texture) of ``sprite``'s animation frame ``frame`` at mip level ``level``."""
+    """The material (and texture) of ``sprite``'s animation frame ``frame`` averaged at level ``level``."""
     return f"{_sprite_asset(sprite)}_{frame}_{level}"
 
 
 def _add_sprite(asset: ET.Element, obj: ObjectGeom) -> tuple[dict, tuple]:
     """The mesh, textures and materials of ``obj``'s sprite (once per sprite); ``(geom attributes, rgba)``.
 
-    A texture and a material per animation frame and mip level
+    A texture and a material per animation frame and averaging level
     (:func:`mjmaze.sprites.textures`); GL draws a texel ``texel x (AMBIENT +
     emission)`` before Doom's light, the geom's colour white.
     """

@@ -26,8 +26,9 @@ import numpy as np
 from mjmaze import palette
 
 SPRITE_WAD = "sprites.wad"
-#: Pictures per animation frame: the picture averaged over blocks of 1, 2, 4, 8 pixels (:func:`textures`).
-MIP_LEVELS = 4
+#: Pictures per animation frame: the picture averaged over a square of this many pixels around
+#: each pixel (:func:`textures`), for a frame pixel that covers about as many.
+BOX_SIZES = (1, 2, 3, 4, 6, 8, 12)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -131,23 +132,26 @@ def _unlit(sprite: Sprite, frame: int) -> np.ndarray:
     return rgb / 255.0 * (palette.SPRITE_FULLBRIGHT if bright else palette.SPRITE_LIT)
 
 
-def _block_mean(colour: np.ndarray, opaque: np.ndarray, block: int) -> np.ndarray:
-    """``colour`` averaged over its opaque pixels in blocks of ``block`` x ``block`` pixels, at full size."""
-    height, width, _ = colour.shape
-    rows, cols = -(-height // block) * block, -(-width // block) * block
-    weight = np.zeros((rows, cols))
-    weight[:height, :width] = opaque
-    total = np.zeros((rows, cols, 3))
-    total[:height, :width] = colour * opaque[..., None]
-    pooled = total.reshape(rows // block, block, cols // block, block, 3).sum(axis=(1, 3))
-    count = weight.reshape(rows // block, block, cols // block, block).sum(axis=(1, 3))
-    mean = pooled / np.maximum(count, 1)[..., None]
-    return np.repeat(np.repeat(mean, block, axis=0), block, axis=1)[:height, :width]
+def _box_mean(colour: np.ndarray, opaque: np.ndarray, box: int) -> np.ndarray:
+    """``colour`` averaged over the opaque pixels of the ``box`` x ``box`` square around each pixel."""
+    low, high = box // 2, box - box // 2  # the square spans [i - low, i + high)
+
+    def box_sum(values: np.ndarray) -> np.ndarray:  # over rows then columns, by cumulative sums
+        for axis in (0, 1):
+            padded = np.pad(values, [(low, high) if a == axis else (0, 0) for a in range(values.ndim)])
+            cumulative = np.concatenate([np.zeros_like(np.take(padded, [0], axis=axis)), np.cumsum(padded, axis=axis)], axis)
+            n = values.shape[axis]
+            values = np.take(cumulative, np.arange(n) + box, axis=axis) - np.take(cumulative, np.arange(n), axis=axis)
+        return values
+
+    total = box_sum(colour * opaque[..., None])
+    count = box_sum(opaque.astype(np.float64))
+    return np.where(count[..., None] > 0, total / np.maximum(count, 1e-9)[..., None], colour)
 
 
 @functools.lru_cache(maxsize=None)
 def textures(sprite: Sprite) -> tuple[np.ndarray, np.ndarray]:
-    """What mjmaze draws of ``sprite``: ``(texels (frames, MIP_LEVELS, h, w, 3) uint8, emission (frames,))``.
+    """What mjmaze draws of ``sprite``: ``(texels (frames, len(BOX_SIZES), h, w, 3) uint8, emission (frames,))``.
 
     Per animation frame, its colours as GL must draw them before Doom's light
     (:class:`mjmaze.look.DoomLight`): a sector-lit frame's palette colours
@@ -156,10 +160,12 @@ def textures(sprite: Sprite) -> tuple[np.ndarray, np.ndarray]:
     (AMBIENT + emission)``: texels are the colours over ``AMBIENT + emission``,
     the emission what the brightest channel needs beyond ``AMBIENT``.
 
-    Level ``k`` of a frame is the picture averaged over blocks of ``2**k``
-    pixels (its opaque ones), as the released frames average a sprite that
-    320x180 pixels drew into 112x64 (``cv2.INTER_AREA``): :class:`SpriteView`
-    shows the level of each sprite's depth. Transparent texels take the
+    Level ``k`` of a frame is the picture averaged, at each pixel, over the
+    opaque pixels of the ``BOX_SIZES[k]``-wide square around it, as the
+    released frames average a sprite that 320x180 pixels drew into 112x64
+    (``cv2.INTER_AREA``: a frame pixel is the mean of the sprite under it):
+    :class:`mjmaze.look.SpriteView` shows each sprite the level of its depth,
+    and GL's nearest texel is then that mean. Transparent texels take the
     frame's mean colour (only the mesh's edges could sample them).
     """
     opaque, _ = shape(sprite)
@@ -169,7 +175,7 @@ def textures(sprite: Sprite) -> tuple[np.ndarray, np.ndarray]:
         colour[~opaque] = colour[opaque].mean(axis=0)
         white = max(float(colour.max()), palette.AMBIENT)
         emission.append(white - palette.AMBIENT)
-        levels = [_block_mean(colour, opaque, 2**level) for level in range(MIP_LEVELS)]
+        levels = [_box_mean(colour, opaque, box) for box in BOX_SIZES]
         texels.append(np.round(np.stack(levels) / white * 255).astype(np.uint8))
     return np.stack(texels), np.array(emission)
 

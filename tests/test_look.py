@@ -237,12 +237,12 @@ def object_colour_at_step(env, step):
     return object_colour(env, "item_0", (0.0, 0.0, 0.0), first_step=step)
 
 
-@pytest.mark.parametrize("distance, level", [(0.4, 0), (0.6, 1), (1.0, 2), (2.0, 3), (3.0, 3)])
+@pytest.mark.parametrize("distance, level", [(0.4, 0), (0.6, 1), (1.0, 2), (2.0, 4), (3.0, 5)])
 def test_a_sprite_shows_its_picture_averaged_as_the_released_resize_averages_it(distance, level):
     # A released 320x180 frame drew a map unit (a sprite pixel) 0.94 / d
     # pixels wide, then averaged 2.86 of them into each 112x64 pixel: a frame
-    # pixel covers ~3 sprite pixels per metre of depth. mjmaze shows the
-    # picture averaged over blocks of about that many pixels (2^level).
+    # pixel is the mean of the ~3 d x 3 d sprite pixels under it. mjmaze shows
+    # the picture averaged over the square of about that many around each pixel.
     env = stone_room_with(sprites.MEDIKIT)
     physics = env.physics
     ids = physics.object_ids(["item_0"])
@@ -252,11 +252,13 @@ def test_a_sprite_shows_its_picture_averaged_as_the_released_resize_averages_it(
     material = physics.model.id2name(physics.model.geom_matid[ids[1][0]], "material")
     env.task.close()
     assert material == mjcf.sprite_material(sprites.MEDIKIT, 0, level)
-    texels = sprites.textures(sprites.MEDIKIT)[0][0, level]
-    block = 2**level  # each block of the picture is one colour, its pixels' mean
-    assert (texels[:block, :block] == texels[0, 0]).all()
-    if level == 3:  # far off, the grey case and green cross are averaged into a few colours
-        assert len(np.unique(drawn, axis=0)) <= 8
+    assert sprites.BOX_SIZES[level] == pytest.approx(3.05 * distance, rel=0.45)
+    texels = sprites.textures(sprites.MEDIKIT)[0][0].astype(float)
+    box, (row, col) = sprites.BOX_SIZES[level], (11, 14)  # inside the case: every pixel around is opaque
+    square = texels[0, row - box // 2:row - box // 2 + box, col - box // 2:col - box // 2 + box]
+    assert texels[level, row, col] == pytest.approx(square.reshape(-1, 3).mean(axis=0), abs=1)
+    if level >= 4:  # far off, the grey case and green cross are averaged into a few colours
+        assert len(np.unique(drawn, axis=0)) <= 20
 
 
 def test_two_colour_items_are_the_green_and_the_red_armour_alternately():

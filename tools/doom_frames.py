@@ -52,6 +52,9 @@ WALL_PAD = 8  # the generator's half thickness of a wall block
 SIZE = (112, 64)
 ANIMATION_TICS = 13  # Doom's armour sprites: ARM1 A 6 tics, B (bright) 7
 ANIMATION_A_TICS = 6
+# mjmaze's sprites animate by the level's tic, 4 a step from tic 10: 13 steps show every tic of the
+# armours' 13-tic cycle once (and most of the keycards' and soulsphere's).
+MJMAZE_ANIMATION_STEPS = 13
 RAISE_TICS = 8  # the pistol is still being raised for ~6 tics after the released start (tic 10)
 # Doom textures of the released rooms: (walls, floor, ceiling).
 STONE = ("STONE2", "FLAT1_1", "MFLR8_1")  # Labyrinth, Find-and-return, K-item
@@ -188,7 +191,9 @@ def doom_view(text: str, weapon: bool = True) -> tuple[np.ndarray, np.ndarray]:
 
 
 def mjmaze_view(env, spawn: tuple[float, float, int], objects: list[str]) -> tuple[np.ndarray, np.ndarray]:
-    """mjmaze's 112x64 frame at ``spawn`` (map units, degrees) and where ``objects`` are seen."""
+    """mjmaze's 112x64 frame at ``spawn`` (map units, degrees), averaged over the first
+    :data:`MJMAZE_ANIMATION_STEPS` steps' animation frames (as ``doom_view`` averages the blink), and
+    where ``objects`` are seen."""
     task, physics = env.task, env.physics
     physics.set_agent_pose(spawn[0] / UNITS, spawn[1] / UNITS, math.radians(spawn[2]))
     physics.forward()
@@ -196,7 +201,12 @@ def mjmaze_view(env, spawn: tuple[float, float, int], objects: list[str]) -> tup
     mask = np.isin(task.segmentation(physics), geoms).astype(np.float64)
     rows, cols, _ = look.pistol_pixels(*SIZE)
     mask[rows, cols] = 0.0  # what the pistol hides
-    return task.get_observation(physics)["pixels"].copy(), mask
+    frames = []
+    for step in range(MJMAZE_ANIMATION_STEPS):
+        task.state["steps"][task.row] = step
+        frames.append(task.get_observation(physics)["pixels"].astype(np.float64))
+    task.state["steps"][task.row] = 0
+    return np.mean(frames, axis=0).round().astype(np.uint8), mask
 
 
 def corridor_poses(config: configs.MazeConfig, cell: tuple[int, int]) -> dict[int, tuple[int, int, int]]:

@@ -34,7 +34,7 @@ def wanted_lumps(source: dict[str, bytes]) -> dict[str, bytes]:
 
 
 def figure(path: pathlib.Path) -> None:
-    """Each sprite's frames as Freedoom draws them, then mjmaze's first frame averaged over 2, 4, 8 pixels, 4x."""
+    """Each sprite's frames as Freedoom draws them, then mjmaze's first frame at each averaging level, 4x."""
     import numpy as np
     from PIL import Image
 
@@ -46,7 +46,7 @@ def figure(path: pathlib.Path) -> None:
             tiles.append(np.where(opaque[..., None], rgb, 40))
         texels, emission = sprites.textures(sprite)
         opaque, _ = sprites.shape(sprite)
-        for level in range(1, sprites.MIP_LEVELS):  # frame A averaged over 2, 4, 8 pixels
+        for level in range(1, len(sprites.BOX_SIZES)):  # frame A averaged over 2, 3, 4, 6, 8, 12 pixels
             tiles.append(np.where(opaque[..., None], texels[0, level], 40))
         height = max(t.shape[0] for t in tiles)
         row = np.concatenate([np.pad(t, ((0, height - t.shape[0]), (0, 4), (0, 0)), constant_values=0) for t in tiles], 1)
