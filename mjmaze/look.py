@@ -131,12 +131,16 @@ class SpriteView:
                        for f in range(len(kind.frames))]
                 table[k, :, level] = np.array(ids)[frames]
         self._materials = xp.asarray(table.reshape(-1), device=device)
-        self._kind = xp.asarray(np.array([kinds.index(sprite) for sprite in of_geom], dtype=np.int64), device=device)
-        # A frame pixel spans depth / (focal length in pixels) metres, each sprite pixel a map unit;
-        # the level whose square is nearest (geometrically) to a frame pixel's footprint is shown.
-        self._pixels_per_texel = mjcf.DOOM_FOCAL_ACROSS * width * mjcf.MAP_UNIT
+        self._levels = levels
+        # Where each geom's kind starts in the flat table.
+        self._first = xp.asarray(np.array([kinds.index(s) * self._cycle * levels for s in of_geom], dtype=np.int64),
+                                 device=device)
+        # A frame pixel spans depth / (focal length in pixels) metres, each sprite pixel a map unit:
+        # it covers depth / (focal x MAP_UNIT) sprite pixels. The level shown is the one whose square
+        # is nearest (geometrically) to that, found among the depths where the nearest one changes.
         boxes = np.array(sprites.BOX_SIZES, dtype=np.float64)
-        self._thresholds = [float(t) for t in np.sqrt(boxes[:-1] * boxes[1:])]
+        depths = np.sqrt(boxes[:-1] * boxes[1:]) * mjcf.DOOM_FOCAL_ACROSS * width * mjcf.MAP_UNIT
+        self._level_depths = xp.asarray(depths, device=device)
 
     def __len__(self) -> int:
         return len(self.geom_ids)
@@ -151,12 +155,8 @@ class SpriteView:
         quat = xp.stack([xp.cos(half), zero, zero, xp.sin(half)], axis=-1)  # turned to the camera's heading
         offset = sprite_xy - eye_xy[:, None, :]
         depth = offset[..., 0] * xp.cos(yaw)[:, None] + offset[..., 1] * xp.sin(yaw)[:, None]
-        footprint = depth / self._pixels_per_texel  # sprite pixels a frame pixel covers
-        level = xp.zeros(depth.shape, dtype=xp.int64, device=rules.device(depth))
-        for threshold in self._thresholds:
-            level = level + xp.astype(footprint > threshold, xp.int64)
-        tic = xp.astype(tics, xp.int64)[:, None] % self._cycle
-        index = (self._kind[None, :] * self._cycle + tic) * len(sprites.BOX_SIZES) + level
+        level = xp.searchsorted(self._level_depths, xp.astype(depth, self._level_depths.dtype))
+        index = self._first + (xp.astype(tics, xp.int64)[:, None] % self._cycle) * self._levels + level
         return xp.reshape(xp.take(self._materials, xp.reshape(index, (-1,)), axis=0), index.shape), quat
 
 
@@ -228,6 +228,8 @@ class DoomLight:
         self._cell, self._half_grid = float(cell_size), grid_size / 2
         self._face = walls.WALL_THICKNESS / 2 / self._cell  # a wall face's offset from its grid line, in cells
         self._on_face = _ON_PLANE / self._cell
+        # An array, not a Python number: xp.minimum with a scalar would make torch build a tensor per call.
+        self._white = xp.asarray(254.5, dtype=xp.float32, device=device)
 
     def _off_wall_face(self, cells):
         """Cells from a coordinate (in cells from the grid's first line) to the nearest wall face across it."""
@@ -257,5 +259,5 @@ class DoomLight:
         bins = xp.astype(rules.at_most(xp, (_LIGHT_BINS * _NEAREST) / depth, _LIGHT_BINS - 1), xp.int32)
         gain = xp.take(self._gains, xp.reshape(code * _LIGHT_BINS + bins, (-1,)), axis=0)
         # Saturate, as Doom's brightest colormap does: a bright sprite near the eye goes past 255.
-        lit = rules.at_most(xp, xp.astype(frames, xp.float32) * xp.reshape(gain, frames.shape), 254.5)
+        lit = xp.minimum(xp.astype(frames, xp.float32) * xp.reshape(gain, frames.shape), self._white)
         return xp.astype(lit + 0.5, xp.uint8)

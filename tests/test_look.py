@@ -14,7 +14,7 @@ import mjmaze
 from mjmaze import look, mjcf, palette, render, sprites, viz, walls
 from mjmaze.tasks import base, find_return, labyrinth, two_colour
 
-from conftest import find_cell, open_run, place
+from conftest import place
 
 # Mean colour tolerance per channel, in grey levels (0-255).
 CLOSE = 9
