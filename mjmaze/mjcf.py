@@ -60,13 +60,9 @@ class ObjectGeom:
     ``sprite`` (textured style only): Doom's picture of the thing
     (:mod:`mjmaze.sprites`), drawn on a flat mesh in the thing's spot that the
     renderers turn to face the camera every frame, as Doom draws a sprite (a
-    world geom's ``geom_quat`` and material: :class:`mjmaze.look.SpriteView`); ``type``, ``size`` and
-    ``rgba`` then serve the flat style and maps, which show the sprite's mean
-    colour on a cylinder. A sprite object cannot collide.
-
-    ``glow``: the object's material emission. GL draws it ``rgba x (AMBIENT +
-    glow)`` before Doom's light, so a thing brighter than the ambient light can
-    draw (Doom's fullbright frames) keeps its hue: ``rgba`` is scaled down to match.
+    world geom's ``geom_quat`` and material: :class:`mjmaze.look.SpriteView`);
+    ``type``, ``size`` and ``rgba`` then serve the flat style and maps, which
+    show the sprite's mean colour on a cylinder. A sprite object cannot collide.
     """
 
     name: str
@@ -76,30 +72,25 @@ class ObjectGeom:
     z: float
     collides: bool = False
     sprite: sprites.Sprite | None = None
-    glow: float = 0.0
 
     def __post_init__(self):
         if self.sprite is not None and self.collides:
             raise ValueError(f"{self.name}: a sprite object cannot collide (its geom turns to face the camera)")
 
-    def unlit(self, rgba=None) -> np.ndarray:
-        """The RGB (0-1) GL draws the object in before Doom's light, in ``rgba`` (default: its own)."""
-        return np.asarray(self.rgba if rgba is None else rgba, dtype=float)[:3] * (palette.AMBIENT + self.glow)
-
 
 def floor_thing(name: str, shape: str, width: float, height: float, rgba, collides: bool = False,
-                glow: float = 0.0, sprite: sprites.Sprite | None = None) -> ObjectGeom:
+                sprite: sprites.Sprite | None = None) -> ObjectGeom:
     """A Doom thing on the floor, ``width`` x ``height`` map units (its sprite's size), as an object geom.
 
     ``sprite``: Doom's picture, which the textured style draws facing the
     camera; otherwise (and in the flat style and maps) a cylinder
     (``shape="cylinder"``, or a ``"sphere"`` of diameter ``width``) in ``rgba``
-    shows the same width from every side. ``glow``: see :class:`ObjectGeom`.
+    shows the same width from every side.
     """
     radius, height = width / 2 * MAP_UNIT, height * MAP_UNIT
     if shape == "sphere":
-        return ObjectGeom(name, "sphere", (radius,), rgba, radius, collides, sprite=sprite, glow=glow)
-    return ObjectGeom(name, "cylinder", (radius, height / 2), rgba, height / 2, collides, sprite=sprite, glow=glow)
+        return ObjectGeom(name, "sphere", (radius,), rgba, radius, collides, sprite=sprite)
+    return ObjectGeom(name, "cylinder", (radius, height / 2), rgba, height / 2, collides, sprite=sprite)
 
 
 def sprite_thing(name: str, sprite: sprites.Sprite) -> ObjectGeom:
@@ -203,13 +194,6 @@ def build_xml(
         attrs = dict(name=obj.name, type=obj.type, size=" ".join(map(str, obj.size)))
         if obj.sprite is not None and visual_style == "textured":
             attrs, rgba = _add_sprite(asset, obj)
-        elif obj.glow:
-            # One material per glow (Two-colour's 90 items share one).
-            material = f"glow_{obj.glow}"
-            if asset.find(f"material[@name='{material}']") is None:
-                ET.SubElement(asset, "material", name=material, emission=str(obj.glow),
-                              specular="0", shininess="0", reflectance="0")
-            attrs["material"] = material
         attrs["rgba"] = " ".join(map(str, rgba))
         if batch and obj.collides:
             colliding.append((obj, attrs))
