@@ -312,7 +312,7 @@ def _add_sprite(asset: ET.Element, obj: ObjectGeom) -> tuple[dict, tuple]:
         # and finds a volume), recentred by it: write_sprites writes them as they are.
         verts, texcoords = sprites.mesh_quads(obj.sprite, obj.z, MAP_UNIT)
         verts[..., 0] += np.arange(4) * 1e-3
-        faces = np.array([(0, 1, 2), (0, 2, 3)])[None] + (np.arange(len(verts)) * 4)[:, None, None]
+        faces = walls.quad_faces(len(verts))
         ET.SubElement(asset, "mesh", name=name, inertia="shell",
                       vertex=" ".join(f"{v:.5f}" for v in verts.ravel()),
                       face=" ".join(map(str, faces.ravel())),
@@ -354,7 +354,7 @@ def write_sprites(model: mujoco.MjModel, objects: Sequence[ObjectGeom]) -> None:
         verts, texcoords = verts.reshape(-1, 3), texcoords.reshape(-1, 2)
         if model.mesh_vertnum[mesh] != len(verts) or model.mesh_texcoordnum[mesh] != len(texcoords):
             raise RuntimeError(f"the compiled mesh {_sprite_asset(obj.sprite)} is not its quads: vertices were merged")
-        faces = (np.array([(0, 1, 2), (0, 2, 3)])[None] + (np.arange(len(verts) // 4) * 4)[:, None, None]).reshape(-1, 3)
+        faces = walls.quad_faces(len(verts) // 4)
         vert_adr, face_adr = model.mesh_vertadr[mesh], model.mesh_faceadr[mesh]
         model.mesh_vert[vert_adr : vert_adr + len(verts)] = verts
         model.mesh_face[face_adr : face_adr + len(faces)] = faces

@@ -263,15 +263,11 @@ class EgoRenderer:
         flags = (mujoco.mjtRndFlag.mjRND_SEGMENT, mujoco.mjtRndFlag.mjRND_IDCOLOR)
         for flag in flags:
             self._scene.flags[flag] = 1
-        # GL would multiply the id colours by a texture's texels (a sprite's dark pixels).
-        textures = self._option.flags[mujoco.mjtVisFlag.mjVIS_TEXTURE]
-        self._option.flags[mujoco.mjtVisFlag.mjVIS_TEXTURE] = 0
         try:
             colours = self.render(data).astype(np.int64)
         finally:
             for flag in flags:
                 self._scene.flags[flag] = 0
-            self._option.flags[mujoco.mjtVisFlag.mjVIS_TEXTURE] = textures
         # Each scene geom is drawn in the colour of its index + 1 (0 = nothing).
         index = colours[..., 0] + colours[..., 1] * 256 + colours[..., 2] * 65536 - 1
         geoms = np.array(

@@ -138,10 +138,14 @@ def _box_mesh(boxes: np.ndarray, keep: np.ndarray | None = None):
     keep = np.ones((k, _BOX_QUADS), dtype=bool) if keep is None else keep
     verts, texcoords, normals = verts[keep], texcoords[keep], normals[keep]  # (quads, 4, ...), (quads, 3)
     quads = len(verts)
-    quad = np.array([(0, 1, 2), (0, 2, 3)])  # outward-facing, counter-clockwise
-    faces = quad[None] + (np.arange(quads) * 4)[:, None, None]
     face_normals = np.repeat(np.arange(quads), 2)[:, None].repeat(3, axis=1)
-    return verts.reshape(-1, 3), faces.reshape(-1, 3), normals, face_normals, texcoords.reshape(-1, 2)
+    return verts.reshape(-1, 3), quad_faces(quads), normals, face_normals, texcoords.reshape(-1, 2)
+
+
+def quad_faces(quads: int) -> np.ndarray:
+    """``(2 quads, 3)`` vertex indices of ``quads`` quads of 4 vertices each (counter-clockwise as
+    seen from their front), two triangles a quad."""
+    return (np.array([(0, 1, 2), (0, 2, 3)])[None] + (np.arange(quads) * 4)[:, None, None]).reshape(-1, 3)
 
 
 @functools.lru_cache(maxsize=1024)

@@ -20,10 +20,13 @@ from conftest import place
 CLOSE = 9
 
 
-def empty_room(room: palette.Room):
-    """A 10 m arena without walls inside (Two-colour at complexity 0) coloured as ``room``, objects hidden."""
+def empty_room(room: palette.Room, first_item: mjcf.ObjectGeom | None = None):
+    """A 10 m arena without walls inside (Two-colour at complexity 0) coloured as ``room``, objects
+    hidden; ``first_item`` replaces its first item."""
     task = base.task_class(two_colour.TwoColour)(complexity=0, item_cap=0, random=0)
     task.room = room
+    if first_item is not None:
+        task.objects = (two_colour.TOTEM, first_item, *two_colour.ITEMS[1:])
     env = base.make_environment(task)
     env.reset()
     env.physics.show_objects(env.physics.object_ids([o.name for o in task.objects])[1], False)
@@ -172,14 +175,8 @@ ITEMS_1M_AHEAD = {
 
 def stone_room_with(sprite):
     """The empty STONE2 room whose first item is ``sprite`` (a K-item kind), shown."""
-    task = base.task_class(two_colour.TwoColour)(complexity=0, item_cap=0, random=0)
-    task.room = palette.STONE_ROOM
-    task.objects = (two_colour.TOTEM, mjcf.sprite_thing("item_0", sprite), *two_colour.ITEMS[1:])
-    env = base.make_environment(task)
-    env.reset()
-    physics = env.physics
-    physics.show_objects(physics.object_ids([o.name for o in task.objects])[1], False)
-    physics.show_objects(physics.object_ids(["item_0"])[1], True)
+    env = empty_room(palette.STONE_ROOM, mjcf.sprite_thing("item_0", sprite))
+    env.physics.show_objects(env.physics.object_ids(["item_0"])[1], True)
     return env
 
 
