@@ -28,6 +28,12 @@ TICS_PER_STEP = core.TICS_PER_STEP
 MAP_UNIT = mjcf.MAP_UNIT  # metres
 THRUST_PER_TIC = 25 * 2048 / 65536 * MAP_UNIT  # m/tic gained per tic: forwardmove 0x19 (walking)
 FRICTION = 0xE800 / 0x10000  # share of the velocity a tic keeps
+# A tic a wall or a pillar stops the agent, Doom's slide move (P_SlideMove)
+# keeps the slid velocity less 1/32 (its FUDGE), before friction: Doom slides
+# along walls at 74% of the speed that friction alone leaves (docs/motion.md).
+SLIDE_KEEP = 31 / 32
+# The contacts changed the velocity by more than this (m/s): the agent was stopped this tic.
+_BLOCKED_SQ = 1e-4**2
 TURN_PER_TIC = math.tau * 640 / 65536  # radians: angleturn 640 of a 65536 turn
 SLOW_TURN_TICS = 5  # a turn key's first tics turn at half rate (ZDoom's SLOWTURNTICS)
 # At full speed in open space: 0.261 m and 14.06 degrees per agent step.
@@ -86,8 +92,11 @@ class MazePhysics(mujoco.Physics):
                 mj.mj_step(model, data)
                 qpos[0] -= ahead_x
                 qpos[1] -= ahead_y
-                # The contacts took away the velocity into walls; friction keeps a share of the rest.
-                vx, vy = float(qvel[0]) * FRICTION, float(qvel[1]) * FRICTION
+                # The contacts took away the velocity into walls; friction keeps a share of the rest,
+                # less Doom's slide-move loss where a contact stopped the agent.
+                slid_x, slid_y = float(qvel[0]), float(qvel[1])
+                keep = FRICTION * (SLIDE_KEEP if (slid_x - vx) ** 2 + (slid_y - vy) ** 2 > _BLOCKED_SQ else 1.0)
+                vx, vy = slid_x * keep, slid_y * keep
                 tic_xy[tic] = qpos[:2]
         qvel[0], qvel[1] = vx, vy
         self.turn_held = held
@@ -158,11 +167,13 @@ def batch_tics(xp, qpos, qvel, forward, turn, turn_held, timestep: float, path, 
             xp.astype(qpos[:, 2], xp.float64), forward, turn, turn_held, timestep,
         )
         qvel[:, 0], qvel[:, 1], qvel[:, 2] = vx, vy, yaw_rate
-        ahead = qvel[:, :2] * timestep
+        moved = qvel[:, :2].clone() if hasattr(qvel, "clone") else qvel[:, :2].copy()
+        ahead = moved * timestep
         qpos[:, :2] += ahead
         step_contacts()
         qpos[:, :2] -= ahead
-        qvel[:, :2] *= FRICTION
+        blocked = xp.sum((qvel[:, :2] - moved) ** 2, axis=1) > _BLOCKED_SQ
+        qvel[:, :2] *= xp.astype(xp.where(blocked, FRICTION * SLIDE_KEEP, FRICTION), qvel.dtype)[:, None]
         path[:, tic] = qpos[:, :2]
     return turn_held, look.walking_bob(xp, vx, vy, timestep)
 

@@ -431,7 +431,7 @@ def armour_parts() -> None:
     7. Per picture, the armour's pixels (labels buffer) split by hue: the
     green armour's green chest, Freedoom's "blue" armour's red body; the rest
     is their grey plates and edges. Two-colour draws each item in its
-    coloured part's colour averaged over the blink (until ``TwoColour-v7``, which draws the pictures).
+    coloured part's colour averaged over the blink (until ``TwoColour-v8``, which draws the pictures).
     """
     env = empty_arena("slime", pistol=False)
     config, physics = env.task.config, env.physics

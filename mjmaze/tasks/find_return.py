@@ -17,6 +17,10 @@ Arguments
 Metric
     ``success``: target found and return reached; ``target_found``.
 Version History
+    * v5 (2026-11-27): the agent slides along walls as Doom
+      does: a tic a wall or a pillar stops it, it keeps 31/32 of the slid
+      velocity (Doom's slide move), so it slides at 74% of the speed
+      before (docs/motion.md, "Along walls").
     * v4 (2026-11-26): things (exits, items, pillars, totems) lit as Doom
       lights sprites: by the sector's light over depth, between the two
       walls' curves (``palette.THING_LIGHT``); before, the old lamp's curve,
@@ -110,7 +114,7 @@ class FindReturn(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="find_return",
     task=FindReturn,
-    gym_id="mjmaze/FindReturn-v4",
+    gym_id="mjmaze/FindReturn-v5",
     seed_code=2,
     difficulty="size",
     difficulties=SIZES,

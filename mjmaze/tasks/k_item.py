@@ -22,6 +22,10 @@ The collection order is item kind 1, then 2, ... by the released files' colour
 codes: green, red, blue, cyan, magenta, yellow, then two greys, which also
 differ in shape (:data:`KINDS`).
 Version History
+    * v6 (2026-11-27): the agent slides along walls as Doom
+      does: a tic a wall or a pillar stops it, it keeps 31/32 of the slid
+      velocity (Doom's slide move), so it slides at 74% of the speed
+      before (docs/motion.md, "Along walls").
     * v5 (2026-11-26): every kind drawn as the thing the released generator
       places, in Freedoom 0.10.1's own pictures (the paper's game data),
       turning to face the camera as Doom's sprites do; kinds 3-8 were
@@ -139,7 +143,7 @@ class KItem(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="k_item",
     task=KItem,
-    gym_id="mjmaze/KItem-v5",
+    gym_id="mjmaze/KItem-v6",
     seed_code=3,
     difficulty="num_items",
     difficulties=NUM_ITEMS,

@@ -16,6 +16,10 @@ Arguments
 Metric
     ``success``: whether the exit was reached (success rate = mean over episodes).
 Version History
+    * v7 (2026-11-27): the agent slides along walls as Doom
+      does: a tic a wall or a pillar stops it, it keeps 31/32 of the slid
+      velocity (Doom's slide move), so it slides at 74% of the speed
+      before (docs/motion.md, "Along walls").
     * v6 (2026-11-26): the exit drawn as Freedoom 0.10.1's green armour (the
       paper's game data), a picture turning to face the camera as Doom's
       sprites do, instead of a banded cylinder (docs/paper_agents.md, item 17).
@@ -92,7 +96,7 @@ class Labyrinth(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="labyrinth",
     task=Labyrinth,
-    gym_id="mjmaze/Labyrinth-v6",
+    gym_id="mjmaze/Labyrinth-v7",
     seed_code=1,
     difficulty="size",
     difficulties=SIZES,

@@ -36,6 +36,10 @@ Arguments
 Metric
     ``duration``: tics survived (max 2100); also ``health`` and ``totem_green``.
 Version History
+    * v8 (2026-11-27): the agent slides along walls as Doom
+      does: a tic a wall or a pillar stops it, it keeps 31/32 of the slid
+      velocity (Doom's slide move), so it slides at 74% of the speed
+      before (docs/motion.md, "Along walls").
     * v7 (2026-11-26): items drawn as Freedoom 0.10.1's own pictures of the
       green and the "blue" (red) armour (the paper's game data), turning to
       face the camera as Doom's sprites do, instead of cylinders in their
@@ -338,7 +342,7 @@ class TwoColour(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="two_colour",
     task=TwoColour,
-    gym_id="mjmaze/TwoColour-v7",
+    gym_id="mjmaze/TwoColour-v8",
     seed_code=4,
     difficulty="complexity",
     difficulties=COMPLEXITIES,
