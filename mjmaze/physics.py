@@ -67,7 +67,8 @@ class MazePhysics(mujoco.Physics):
         the tic (positions moved ahead by ``qvel * dt`` for ``mj_step``, then
         moved back), and the arena's contacts (see ``xml_templates/arena.xml``)
         take exactly the predicted penetration out of the velocity, so momentum
-        into a wall is lost and the rest slides along it. Plain ``mj_step``
+        into a wall is lost and the rest slides along it (at :data:`SLIDE_KEEP`
+        of its speed a tic, as Doom's slide move). Plain ``mj_step``
         finds a contact only after the agent has sunk up to a tic's travel
         (6 cm) into a wall, then pushes it back: a 6 cm jitter against every wall.
         """
@@ -167,11 +168,12 @@ def batch_tics(xp, qpos, qvel, forward, turn, turn_held, timestep: float, path, 
             xp.astype(qpos[:, 2], xp.float64), forward, turn, turn_held, timestep,
         )
         qvel[:, 0], qvel[:, 1], qvel[:, 2] = vx, vy, yaw_rate
-        moved = qvel[:, :2].clone() if hasattr(qvel, "clone") else qvel[:, :2].copy()
+        moved = xp.asarray(qvel[:, :2], copy=True)
         ahead = moved * timestep
         qpos[:, :2] += ahead
         step_contacts()
         qpos[:, :2] -= ahead
+        # Friction, and Doom's slide-move loss in the worlds whose contacts stopped the agent.
         blocked = xp.sum((qvel[:, :2] - moved) ** 2, axis=1) > _BLOCKED_SQ
         qvel[:, :2] *= xp.astype(xp.where(blocked, FRICTION * SLIDE_KEEP, FRICTION), qvel.dtype)[:, None]
         path[:, tic] = qpos[:, :2]
