@@ -168,13 +168,13 @@ def batch_tics(xp, qpos, qvel, forward, turn, turn_held, timestep: float, path, 
             xp.astype(qpos[:, 2], xp.float64), forward, turn, turn_held, timestep,
         )
         qvel[:, 0], qvel[:, 1], qvel[:, 2] = vx, vy, yaw_rate
-        moved = xp.asarray(qvel[:, :2], copy=True)
-        ahead = moved * timestep
+        ahead = qvel[:, :2] * timestep
         qpos[:, :2] += ahead
         step_contacts()
         qpos[:, :2] -= ahead
-        # Friction, and Doom's slide-move loss in the worlds whose contacts stopped the agent.
-        blocked = xp.sum((qvel[:, :2] - moved) ** 2, axis=1) > _BLOCKED_SQ
+        # Friction, and Doom's slide-move loss in the worlds whose contacts stopped the agent
+        # (their velocity is no longer the tic's (vx, vy)).
+        blocked = (qvel[:, 0] - vx) ** 2 + (qvel[:, 1] - vy) ** 2 > _BLOCKED_SQ
         qvel[:, :2] *= xp.astype(xp.where(blocked, FRICTION * SLIDE_KEEP, FRICTION), qvel.dtype)[:, None]
         path[:, tic] = qpos[:, :2]
     return turn_held, look.walking_bob(xp, vx, vy, timestep)
