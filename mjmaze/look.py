@@ -234,7 +234,8 @@ class DoomLight:
     def _off_wall_face(self, cells):
         """Cells from a coordinate (in cells from the grid's first line) to the nearest wall face across it."""
         xp = self._xp
-        return xp.abs(xp.abs(cells - xp.round(cells)) - self._face)
+        off_line = xp.abs(cells - xp.round(cells))
+        return xp.minimum(xp.abs(off_line - self._face), off_line)  # a wall's side, or an end or the outer wall
 
     def __call__(self, frames, depth, eye, yaw):
         """``frames`` (uint8 ``(B, H, W, 3)``) in Doom's light: new frames.

@@ -96,7 +96,14 @@ class MazePhysics(mujoco.Physics):
                 # The contacts took away the velocity into walls; friction keeps a share of the rest,
                 # less Doom's slide-move loss where a contact stopped the agent.
                 slid_x, slid_y = float(qvel[0]), float(qvel[1])
-                keep = FRICTION * (SLIDE_KEEP if (slid_x - vx) ** 2 + (slid_y - vy) ** 2 > _BLOCKED_SQ else 1.0)
+                dx, dy = vx - slid_x, vy - slid_y
+                dd = dx * dx + dy * dy
+                if dd > _BLOCKED_SQ:
+                    closing = slid_x * dx + slid_y * dy
+                    reached = min(max(closing / (closing + dd), 1 - SLIDE_KEEP), 1.0)
+                    keep = FRICTION * (1.0 - reached)
+                else:
+                    keep = FRICTION
                 vx, vy = slid_x * keep, slid_y * keep
                 tic_xy[tic] = qpos[:2]
         qvel[0], qvel[1] = vx, vy

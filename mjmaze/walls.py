@@ -36,19 +36,36 @@ def wall_segments(grid_size: int, cell_size: float) -> np.ndarray:
     """Every possible wall segment of the grid as rows ``(x, y, half_x, half_y)``.
 
     Horizontal segments come first, in ``h_walls`` order, then vertical ones in
-    ``v_walls`` order (see :mod:`mjmaze.maze`). Segments overlap by the wall
-    thickness at the corners so that corners are closed.
+    ``v_walls`` order (see :mod:`mjmaze.maze`). As the released mazes build
+    them: an inner wall is a box one cell long, ends flush with the grid lines,
+    centred on its line; the outer walls stand outside the grid's edge.
     """
-    n, half = grid_size, (grid_size - 1) / 2
-    long_half, short_half = (cell_size + WALL_THICKNESS) / 2, WALL_THICKNESS / 2
+    n = grid_size
     rows = []
     for i in range(n + 1):
         for j in range(n):
-            rows.append(((j - half) * cell_size, (i - 0.5 - half) * cell_size, long_half, short_half))
+            rows.append(_box(True, i, j, j + 1, n, cell_size))
     for i in range(n):
         for j in range(n + 1):
-            rows.append(((j - 0.5 - half) * cell_size, (i - half) * cell_size, short_half, long_half))
+            rows.append(_box(False, j, i, i + 1, n, cell_size))
     return np.array(rows, dtype=np.float64)
+
+
+def _box(horizontal: bool, line: int, start: int, stop: int, n: int, cell_size: float) -> tuple:
+    """The box ``(x, y, half_x, half_y)`` of cells ``start..stop-1`` of wall on grid line ``line``.
+
+    The released generator (``generate_*.py``) pads each inner wall 8 map
+    units either side of its line and not past its ends; the maze's edge is
+    the sector's own boundary, with nothing inside it: so an inner wall's end
+    is its grid line, and the outer wall's face is the edge itself (its box
+    lies outside, long enough to close the corners).
+    """
+    half, thick = (n - 1) / 2, WALL_THICKNESS / 2
+    outer = line in (0, n)
+    across = (line - 0.5 - half) * cell_size + (thick if line == n else -thick if line == 0 else 0.0)
+    a, b = (start - 0.5 - half) * cell_size, (stop - 0.5 - half) * cell_size
+    along, along_half = (a + b) / 2, (b - a) / 2 + (2 * thick if outer else 0.0)
+    return (along, across, along_half, thick) if horizontal else (across, along, thick, along_half)
 
 
 def placeholder_quads(grid_size: int, cell_size: float) -> int:
@@ -200,17 +217,14 @@ class WallLayout:
 
 
 def wall_runs(h_walls: np.ndarray, v_walls: np.ndarray, cell_size: float) -> np.ndarray:
-    """Straight runs of adjacent walls as boxes ``(x, y, half_x, half_y)``."""
+    """Straight runs of adjacent walls as boxes ``(x, y, half_x, half_y)`` (placed as :func:`_box` places them)."""
     n = h_walls.shape[1]
-    half, thick = (n - 1) / 2, WALL_THICKNESS / 2
     boxes = []
     for line in range(n + 1):
         for start, stop in _runs(h_walls[line]):  # columns start..stop-1 on horizontal line `line`
-            x0, x1 = (start - 0.5 - half) * cell_size, (stop - 0.5 - half) * cell_size
-            boxes.append(((x0 + x1) / 2, (line - 0.5 - half) * cell_size, (x1 - x0) / 2 + thick, thick))
+            boxes.append(_box(True, line, start, stop, n, cell_size))
         for start, stop in _runs(v_walls[:, line]):  # rows start..stop-1 on vertical line `line`
-            y0, y1 = (start - 0.5 - half) * cell_size, (stop - 0.5 - half) * cell_size
-            boxes.append(((line - 0.5 - half) * cell_size, (y0 + y1) / 2, thick, (y1 - y0) / 2 + thick))
+            boxes.append(_box(False, line, start, stop, n, cell_size))
     return np.array(boxes, dtype=np.float64).reshape(-1, 4)
 
 
@@ -222,7 +236,7 @@ MAX_PIECE_LENGTH = 1.0
 
 def _pieces_per_segment(cell_size: float) -> int:
     """Upper bound on mesh pieces per wall segment (a run of L segments has at most L times this)."""
-    return math.ceil((cell_size + WALL_THICKNESS) / MAX_PIECE_LENGTH)
+    return math.ceil((cell_size + 2 * WALL_THICKNESS) / MAX_PIECE_LENGTH)
 
 
 def wall_pieces(h_walls: np.ndarray, v_walls: np.ndarray, cell_size: float) -> tuple[np.ndarray, np.ndarray]:
