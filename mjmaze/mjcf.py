@@ -201,14 +201,25 @@ def build_xml(
             ET.SubElement(arena, "geom", **{"class": "item"}, pos=f"0 0 {obj.z}", group=str(VISIBLE_GROUP), **attrs)
         elif obj.collides:
             body = ET.SubElement(worldbody, "body", name=obj.name, mocap="true", pos=f"0 0 {obj.z}")
-            ET.SubElement(body, "geom", **{"class": "item"}, contype="1", conaffinity="1", **attrs)
+            ET.SubElement(body, "geom", **{"class": "item"}, **attrs)
+            ET.SubElement(body, "geom", **{"class": "item"}, **_blocking_square(obj))
         else:
             ET.SubElement(worldbody, "geom", **{"class": "item"}, pos=f"0 0 {obj.z}", **attrs)
     for obj, attrs in colliding:
         ET.SubElement(arena, "geom", **{"class": "item"}, pos=f"0 0 {obj.z}", group=str(VISIBLE_GROUP), **attrs)
-        ET.SubElement(arena, "geom", **{"class": "item"}, pos=f"0 0 {obj.z}", **{
-            **attrs, "name": obj.name + COLLISION_SUFFIX, "group": "3", "contype": "1", "conaffinity": "1"})
+        ET.SubElement(arena, "geom", **{"class": "item"}, pos=f"0 0 {obj.z}", **_blocking_square(obj))
     return ET.tostring(root, encoding="unicode")
+
+
+def _blocking_square(obj: ObjectGeom) -> dict[str, str]:
+    """The geom attributes of a colliding object's blocking twin (never drawn).
+
+    Doom blocks a thing by a square of its radius, aligned with the map's axes
+    (as the agent's own box in ``xml_templates/arena.xml``), whatever its picture.
+    """
+    radius, half_height = obj.size[0], obj.size[1] if len(obj.size) > 1 else obj.size[0]
+    return {"name": obj.name + COLLISION_SUFFIX, "type": "box", "size": f"{radius} {radius} {half_height}",
+            "group": "3", "contype": "1", "conaffinity": "1"}
 
 
 #: Doom's projection as ViZDoom draws the released 320x180 frames: a focal

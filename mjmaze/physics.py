@@ -28,9 +28,11 @@ TICS_PER_STEP = core.TICS_PER_STEP
 MAP_UNIT = mjcf.MAP_UNIT  # metres
 THRUST_PER_TIC = 25 * 2048 / 65536 * MAP_UNIT  # m/tic gained per tic: forwardmove 0x19 (walking)
 FRICTION = 0xE800 / 0x10000  # share of the velocity a tic keeps
-# A tic a wall or a pillar stops the agent, Doom's slide move (P_SlideMove)
-# keeps the slid velocity less 1/32 (its FUDGE), before friction: Doom slides
-# along walls at 74% of the speed that friction alone leaves (docs/motion.md).
+# A tic a wall or a pillar stops the agent, Doom's slide move keeps as velocity
+# only the part of the tic's move left after reaching the wall, slid along it,
+# and never more than 31/32 of it (the 1/32 FUDGE it stops short by): Doom
+# slides along walls at 74% of the speed that friction alone leaves, and loses
+# more the tic it meets one (docs/motion.md).
 SLIDE_KEEP = 31 / 32
 # The contacts changed the velocity by more than this (m/s): the agent was stopped this tic.
 _BLOCKED_SQ = 1e-4**2
@@ -96,11 +98,14 @@ class MazePhysics(mujoco.Physics):
                 # The contacts took away the velocity into walls; friction keeps a share of the rest,
                 # less Doom's slide-move loss where a contact stopped the agent.
                 slid_x, slid_y = float(qvel[0]), float(qvel[1])
-                dx, dy = vx - slid_x, vy - slid_y
-                dd = dx * dx + dy * dy
-                if dd > _BLOCKED_SQ:
-                    closing = slid_x * dx + slid_y * dy
-                    reached = min(max(closing / (closing + dd), 1 - SLIDE_KEEP), 1.0)
+                dx, dy = vx - slid_x, vy - slid_y  # the velocity the contacts took (into the wall)
+                stopped = dx * dx + dy * dy
+                if stopped > _BLOCKED_SQ:
+                    # Doom moves the player up to the wall, then slides the rest of the tic's move
+                    # along it, and keeps as velocity only that rest (ZDoom's FSlide::SlideMove): the
+                    # share of the tic spent reaching the wall, at least its 1/32 fudge, is lost.
+                    closing = slid_x * dx + slid_y * dy  # the part of the move into the wall that was left
+                    reached = min(max(closing / (closing + stopped), 1 - SLIDE_KEEP), 1.0)
                     keep = FRICTION * (1.0 - reached)
                 else:
                     keep = FRICTION
@@ -180,9 +185,14 @@ def batch_tics(xp, qpos, qvel, forward, turn, turn_held, timestep: float, path, 
         step_contacts()
         qpos[:, :2] -= ahead
         # Friction, and Doom's slide-move loss in the worlds whose contacts stopped the agent
-        # (their velocity is no longer the tic's (vx, vy)).
-        blocked = (qvel[:, 0] - vx) ** 2 + (qvel[:, 1] - vy) ** 2 > _BLOCKED_SQ
-        qvel[:, :2] *= xp.astype(xp.where(blocked, FRICTION * SLIDE_KEEP, FRICTION), qvel.dtype)[:, None]
+        # (their velocity is no longer the tic's (vx, vy)): as MazePhysics.step.
+        slid_x, slid_y = xp.astype(qvel[:, 0], xp.float64), xp.astype(qvel[:, 1], xp.float64)
+        dx, dy = vx - slid_x, vy - slid_y
+        stopped = dx * dx + dy * dy
+        closing = slid_x * dx + slid_y * dy
+        reached = xp.clip(closing / xp.clip(closing + stopped, min=_BLOCKED_SQ), min=1 - SLIDE_KEEP, max=1.0)
+        keep = xp.where(stopped > _BLOCKED_SQ, FRICTION * (1.0 - reached), FRICTION)
+        qvel[:, :2] *= xp.astype(keep, qvel.dtype)[:, None]
         path[:, tic] = qpos[:, :2]
     return turn_held, look.walking_bob(xp, vx, vy, timestep)
 

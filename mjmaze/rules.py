@@ -22,8 +22,10 @@ import array_api_compat
 
 Array = Any  # a numpy array or a torch tensor
 
-#: An item is picked up when the agent's centre comes this close (floor plane).
-PICKUP_RADIUS = 0.3
+#: An item is picked up when the agent's centre comes this close in x and in y
+#: (metres): Doom touches things by squares aligned with the map, the item's
+#: radius (20 map units, every pickup the scenarios use) plus the player's (16).
+PICKUP_RADIUS = 36 / 128
 
 _MASK32 = 0xFFFFFFFF
 # What a draw is for: the first counter of every uniform(), so draws for
@@ -69,7 +71,7 @@ def within_reach(xp, points: Array, path: Array) -> Array:
     after each tic of the step (Doom tests pick-ups every tic).
     """
     offsets = points[:, :, None, :] - path[:, None, :, :]  # (B, n, tics, 2)
-    return xp.sum(offsets * offsets, axis=-1) < PICKUP_RADIUS**2
+    return xp.max(xp.abs(offsets), axis=-1) < PICKUP_RADIUS
 
 
 def reached(xp, points: Array, path: Array) -> Array:

@@ -107,8 +107,8 @@ LAVA_FIRST_TIC = 23
 START_HEALTH = MAX_HEALTH - LAVA_DAMAGE
 SURVIVAL_REWARD = 0.01 * core.TICS_PER_STEP
 CORRECT_ITEM_REWARD = 1.0
-# Items appear uniformly where the agent can stand: at least its radius from
-# every wall, clear of the totem by both radii, and out of the agent's reach.
+# Items appear uniformly where the agent can stand: its square clear of every
+# wall and of the totem's square, and out of the agent's reach.
 ITEM_WALL_CLEARANCE = core.AGENT_RADIUS
 # Points tried per item, the first free one kept (see TwoColour._free_positions):
 # a point lands on free floor with probability >= 0.79 (complexity 10, the
@@ -129,7 +129,7 @@ _CHUNK_ELEMENTS = 1 << 24
 RED, GREEN = palette.TALL_RED_COLUMN_RGBA, palette.TALL_GREEN_COLUMN_RGBA
 TOTEM = mjcf.floor_thing("totem", "cylinder", 32, 52, RED, collides=True)
 TOTEM_RADIUS = TOTEM.size[0]
-# The agent's centre never comes closer to the totem's than this.
+# The agent's centre never comes closer to the totem's than this in x and in y (both squares).
 TOTEM_CLEARANCE = TOTEM_RADIUS + core.AGENT_RADIUS
 # Where the released map keeps the columns until its script moves one in
 # (4,096 map units west of the centre), and an absent totem stays.
@@ -186,7 +186,7 @@ class TwoColour(core.MazeRules):
         # An imported layout may spawn the agent on the totem's spot: the
         # released script's SetActorPosition then fails and both columns stay
         # parked outside the map, so the episode has no totem (measured in ViZDoom).
-        no_totem = xp.sum((spawn_xy - totem_xy) ** 2, axis=1) < TOTEM_CLEARANCE**2
+        no_totem = xp.max(xp.abs(spawn_xy - totem_xy), axis=1) < TOTEM_CLEARANCE
         totem_xy = xp.where(no_totem[:, None], rules.constant(xp, TOTEM_PARKED_XY, xp.float64, device), totem_xy)
         state = {
             "pose": xp.concat([spawn_xy, xp.zeros((batch, 1), dtype=xp.float64, device=device)], axis=1),
@@ -286,12 +286,13 @@ class TwoColour(core.MazeRules):
             part = items[:, begin : begin + chunk]
             u = rules.uniform(xp, keys[:, None, None, None], rules.DRAW_ITEM, part[:, :, None, None], candidate, axis)
             points = (2 * u - 1) * half  # (B, k, candidates, 2)
-            gap_x = xp.clip(xp.abs(points[..., 0:1] - boxes[..., 0]) - boxes[..., 2], min=0.0)
-            gap_y = xp.clip(xp.abs(points[..., 1:2] - boxes[..., 1]) - boxes[..., 3], min=0.0)
+            # The agent's square fits beside a wall box where it is clear of it in x or in y.
+            gap_x = xp.abs(points[..., 0:1] - boxes[..., 0]) - boxes[..., 2]
+            gap_y = xp.abs(points[..., 1:2] - boxes[..., 1]) - boxes[..., 3]
             free = (
-                (xp.min(gap_x * gap_x + gap_y * gap_y, axis=-1) >= ITEM_WALL_CLEARANCE**2)
-                & (xp.sum((points - totem_xy) ** 2, axis=-1) >= TOTEM_CLEARANCE**2)
-                & (xp.sum((points - agent_xy[:, None, None, :]) ** 2, axis=-1) >= core.PICKUP_RADIUS**2)
+                (xp.min(xp.maximum(gap_x, gap_y), axis=-1) >= ITEM_WALL_CLEARANCE)
+                & (xp.max(xp.abs(points - totem_xy), axis=-1) >= TOTEM_CLEARANCE)
+                & (xp.max(xp.abs(points - agent_xy[:, None, None, :]), axis=-1) >= core.PICKUP_RADIUS)
             )
             first = candidate[..., 0] == xp.argmax(xp.astype(free, xp.int8), axis=-1)[..., None]  # (B, k, candidates)
             xys.append(xp.sum(points * xp.astype(first, xp.float64)[..., None], axis=2))
