@@ -48,7 +48,7 @@ def test_frames_on_a_random_walk_have_dozens_of_colours(style, fewest):
 
 def wall_brightness(env, distance):
     """Mean brightness of the frame's centre, facing the +x outer wall of an empty arena from ``distance`` m."""
-    face = env.task.config.size * env.task.config.cell_size / 2 - walls.WALL_THICKNESS / 2
+    face = env.task.config.size * env.task.config.cell_size / 2  # the outer wall's face: the edge
     values = []
     for y in np.linspace(-2.0, 2.0, 9):  # average over the brick pattern
         place(env, face - distance, y, 0.0)
@@ -140,7 +140,7 @@ def push(env, action, steps):
 @pytest.mark.parametrize("heading", [0.0, 30.0])
 def test_the_agent_stops_at_its_radius_from_a_wall_at_every_tic(heading):
     env = load("two_colour", complexity=0, item_cap=0)
-    face = 5.0 - walls.WALL_THICKNESS / 2
+    face = 5.0  # the outer wall's face is the maze's edge
     place(env, face - 1.0, -2.0, math.radians(heading))
     env.task.health = 10**6  # no death in 50 steps
     path = push(env, FORWARD, 50)
@@ -158,7 +158,7 @@ def test_the_agent_slides_along_a_wall_as_slowly_as_in_vizdoom(angle, doom):
     # alone leaves. ViZDoom's steady slide, map units a step (python tools/doom_motion.py --wall-slide).
     env = load("two_colour", complexity=0, item_cap=0)
     env.task.health = 10**6
-    face = 5.0 - walls.WALL_THICKNESS / 2
+    face = 5.0  # the outer wall's face is the maze's edge
     place(env, 0.0, face - 0.3, math.radians(90 - angle))  # toward the north wall, angle east of its normal
     path = push(env, FORWARD, 12)[3::4]  # the agent's place after each step
     assert path[-1, 1] == pytest.approx(face - base.AGENT_RADIUS, abs=TOLERANCE)  # against the wall
@@ -181,11 +181,12 @@ def test_the_agent_stops_at_its_radius_from_a_pillar_at_every_tic():
 # -- Two-colour items -------------------------------------------------------------
 
 
-def distance_to_walls(config, xy):
+def clearance_from_walls(config, xy):
+    """How far a square centred at each point can grow before it meets a wall (Doom's player is one)."""
     boxes = walls.wall_runs(config.h_walls, config.v_walls, config.cell_size)
-    gap_x = np.maximum(np.abs(xy[:, None, 0] - boxes[:, 0]) - boxes[:, 2], 0)
-    gap_y = np.maximum(np.abs(xy[:, None, 1] - boxes[:, 1]) - boxes[:, 3], 0)
-    return np.hypot(gap_x, gap_y).min(axis=1)
+    gap_x = np.abs(xy[:, None, 0] - boxes[:, 0]) - boxes[:, 2]
+    gap_y = np.abs(xy[:, None, 1] - boxes[:, 1]) - boxes[:, 3]
+    return np.maximum(gap_x, gap_y).min(axis=1)
 
 
 def test_items_cover_the_floor_the_agent_can_stand_on():
@@ -195,8 +196,8 @@ def test_items_cover_the_floor_the_agent_can_stand_on():
         env.reset()
         task, config = env.task, env.task.config
         xy = task.item_xy[task.item_active]
-        assert (distance_to_walls(config, xy) >= base.AGENT_RADIUS).all()
-        assert (np.hypot(*xy.T) >= two_colour.TOTEM_CLEARANCE).all()  # the totem is at the origin
+        assert (clearance_from_walls(config, xy) >= base.AGENT_RADIUS).all()
+        assert (np.abs(xy).max(axis=1) >= two_colour.TOTEM_CLEARANCE).all()  # the totem is at the origin
         # Within 0.25 m of a cell edge: 44% of a cell's area; the old rule gave 0%.
         offset = np.abs((xy + config.size * config.cell_size / 2) % config.cell_size - config.cell_size / 2)
         near_open_edge += int((offset.max(axis=1) > config.cell_size / 2 - 0.25).sum())

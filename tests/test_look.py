@@ -40,7 +40,7 @@ def frame_at(env, x, y, yaw):
 
 def wall_colour(env, distance):
     """Mean colour of the frame's centre facing the +x outer wall from ``distance`` m."""
-    face = env.task.config.size * env.task.config.cell_size / 2 - walls.WALL_THICKNESS / 2
+    face = env.task.config.size * env.task.config.cell_size / 2  # the outer wall's face: the edge
     return frame_at(env, face - distance, 0.0, 0.0)[24:32, 50:62].reshape(-1, 3).mean(axis=0)
 
 
@@ -63,7 +63,7 @@ def test_walls_running_east_west_are_as_much_darker_as_vizdooms():
     # north-south (WallHorizLight / WallVertLight). ViZDoom, facing the room's north
     # (east-west) wall from 1, 2, 4 m: 27, 20, 17 grey; the east (north-south) one: 38, 34, 30.
     env = empty_room(palette.STONE_ROOM)
-    face = env.task.config.size * env.task.config.cell_size / 2 - walls.WALL_THICKNESS / 2
+    face = env.task.config.size * env.task.config.cell_size / 2  # the outer wall's face: the edge
     for distance, doom in ((1.0, 26.7), (2.0, 20.4), (4.0, 16.5)):
         grey = frame_at(env, 0.0, face - distance, np.pi / 2)[24:32, 50:62].mean()
         assert grey == pytest.approx(doom, abs=3), distance
@@ -78,7 +78,7 @@ def test_a_wall_seen_along_a_corridor_is_lit_by_its_depth_as_in_vizdoom():
     # the horizon (python tools/doom_frames.py --light). The nearest band is left
     # out: ViZDoom draws it brighter than any depth of its head-on walls does.
     env = empty_room(palette.STONE_ROOM)
-    face = env.task.config.size * env.task.config.cell_size / 2 - walls.WALL_THICKNESS / 2
+    face = env.task.config.size * env.task.config.cell_size / 2  # the outer wall's face: the edge
     along_north = frame_at(env, -2.0, face - 0.5, 0.0)[26:34]  # the east-west wall on the left
     along_east = frame_at(env, face - 0.5, -2.0, np.pi / 2)[26:34]  # the north-south wall on the right
     env.task.close()
@@ -102,7 +102,7 @@ def test_a_wall_stands_as_tall_in_the_frame_as_in_vizdooms(distance, doom_rows):
     # as wide; python tools/doom_frames.py --projection), 0.8 * 64 / d of mjmaze's 64.
     # Square pixels drew it 1.2x too short (the ids before Labyrinth-v3).
     env = empty_room(palette.SLIME_ROOM)
-    centre = frame_at(env, env.task.config.size - walls.WALL_THICKNESS / 2 - distance, 0.0, 0.0)[:, 50:62]
+    centre = frame_at(env, env.task.config.size - distance, 0.0, 0.0)[:, 50:62]
     env.task.close()
     red, green, blue = (centre[..., k] for k in range(3))
     wall = (green - red < 8) & (blue - red < 6)  # neither the green floor nor the blue ceiling
