@@ -166,6 +166,58 @@ def test_the_agent_slides_along_a_wall_as_slowly_as_in_vizdoom(angle, doom):
     assert slide == pytest.approx(doom, rel=0.06)
 
 
+def free_wall_end(env):
+    """``(x, y)`` of the east end of an inner horizontal wall with nothing beyond it, and the
+    config: the first such end among the env's configurations."""
+    for _ in range(50):
+        env.reset()
+        config = env.task.config
+        n, half = config.size, (config.size - 1) / 2
+        h, v = config.h_walls, config.v_walls
+        for i in range(1, n):
+            for j in range(n - 1):
+                if h[i, j] and not h[i, j + 1] and not v[i - 1, j + 1] and not v[i, j + 1]:
+                    return ((j + 0.5 - half) * config.cell_size, (i - 0.5 - half) * config.cell_size)
+    raise AssertionError("no free wall end in 50 mazes")
+
+
+def test_an_inner_wall_ends_at_its_grid_line():
+    # The released generator pads a wall 8 map units either side of its line, not past its
+    # ends: walking into a wall's end, the agent stops a radius from the grid line.
+    env = load("labyrinth", size=7)
+    x, y = free_wall_end(env)
+    place(env, x + 0.6, y, math.pi)
+    path = push(env, FORWARD, 20)
+    assert path[-1, 0] == pytest.approx(x + base.AGENT_RADIUS, abs=TOLERANCE)
+
+
+def test_the_agent_blocks_as_a_square_at_a_wall_end():
+    # Doom's player is a square aligned with the map: 2 cm of it across a wall's end face
+    # stop it square-on at its radius, where a round agent would roll round the corner.
+    env = load("labyrinth", size=7)
+    x, y = free_wall_end(env)
+    lane = y + walls.WALL_THICKNESS / 2 + base.AGENT_RADIUS - 0.02
+    place(env, x + 0.6, lane, math.pi)
+    path = push(env, FORWARD, 20)
+    assert path[-1, 0] == pytest.approx(x + base.AGENT_RADIUS, abs=TOLERANCE)
+    assert path[-1, 1] == pytest.approx(lane, abs=1e-3)
+
+
+def test_the_tic_it_meets_a_wall_the_agent_keeps_only_the_rest_of_its_move():
+    # ZDoom's slide move takes the player up to the wall and keeps, as velocity, only the
+    # rest of the tic's move slid along it: hitting a wall at speed, 70 degrees from its
+    # normal, the next step slides 14.3 map units in ViZDoom where the speed before gave 26.0
+    # (python tools/doom_motion.py --wall-slide); keeping all the slid speed gave 24.7.
+    env = load("two_colour", complexity=0, item_cap=0)
+    env.task.health = 10**6
+    face = 5.0  # the outer wall's face is the maze's edge
+    place(env, 0.0, face - 48 * base.MAP_UNIT, math.radians(90 - 70))
+    along = np.diff(push(env, FORWARD, 7)[3::4, 0]) / base.MAP_UNIT  # per step, from the first step's end
+    assert along[3] == pytest.approx(26.0, rel=0.05)  # not yet at the wall
+    assert along[4] < 0.75 * along[3]
+    assert along[4] == pytest.approx(14.3, rel=0.25)
+
+
 def test_the_agent_stops_at_its_radius_from_a_pillar_at_every_tic():
     env = load("find_return", size=7)
     red = env.task.config.cell_centre(env.task.config.object_cells[0])
@@ -176,6 +228,17 @@ def test_the_agent_stops_at_its_radius_from_a_pillar_at_every_tic():
     assert distance.min() >= stop - TOLERANCE
     assert distance[-40:].max() <= stop + TOLERANCE
     assert env.task.metrics()["target_found"]
+
+
+@pytest.mark.parametrize("offset, reached", [((0.27, 0.27), True), ((0.29, 0.0), False)])
+def test_an_item_is_within_reach_in_doom_s_square(offset, reached):
+    # Doom touches a thing when the player's square overlaps the item's: within 36 map units
+    # (0.28 m) in x and in y, whatever the distance (0.38 m diagonally, 0.29 m out of reach).
+    env = load("labyrinth", size=5)
+    exit_x, exit_y = env.task.config.cell_centre(env.task.config.object_cells[0])
+    place(env, exit_x - offset[0], exit_y - offset[1], 0.0)
+    step = env.step(0)  # turning on the spot
+    assert (step.reward > 0.5) == reached
 
 
 # -- Two-colour items -------------------------------------------------------------
