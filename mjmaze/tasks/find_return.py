@@ -17,6 +17,12 @@ Arguments
 Metric
     ``success``: target found and return reached; ``target_found``.
 Version History
+    * v6 (2026-11-27): the released mazes' geometry and Doom's squares: inner
+      walls end at their grid lines, the outer wall's face is the maze's
+      edge; the agent and pillars block as squares aligned with the map and
+      items are touched within 0.28 m in x and y, as Doom tests things; the
+      tic the agent meets a wall it keeps only the rest of its move
+      (docs/motion.md, "Walls, squares and the impact tic").
     * v5 (2026-11-27): the agent slides along walls as Doom
       does: a tic a wall or a pillar stops it, it keeps 31/32 of the slid
       velocity (Doom's slide move), so it slides at 74% of the speed
@@ -114,7 +120,7 @@ class FindReturn(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="find_return",
     task=FindReturn,
-    gym_id="mjmaze/FindReturn-v5",
+    gym_id="mjmaze/FindReturn-v6",
     seed_code=2,
     difficulty="size",
     difficulties=SIZES,

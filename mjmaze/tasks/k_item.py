@@ -22,6 +22,12 @@ The collection order is item kind 1, then 2, ... by the released files' colour
 codes: green, red, blue, cyan, magenta, yellow, then two greys, which also
 differ in shape (:data:`KINDS`).
 Version History
+    * v7 (2026-11-27): the released mazes' geometry and Doom's squares: inner
+      walls end at their grid lines, the outer wall's face is the maze's
+      edge; the agent block as squares aligned with the map and
+      items are touched within 0.28 m in x and y, as Doom tests things; the
+      tic the agent meets a wall it keeps only the rest of its move
+      (docs/motion.md, "Walls, squares and the impact tic").
     * v6 (2026-11-27): the agent slides along walls as Doom
       does: a tic a wall or a pillar stops it, it keeps 31/32 of the slid
       velocity (Doom's slide move), so it slides at 74% of the speed
@@ -143,7 +149,7 @@ class KItem(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="k_item",
     task=KItem,
-    gym_id="mjmaze/KItem-v6",
+    gym_id="mjmaze/KItem-v7",
     seed_code=3,
     difficulty="num_items",
     difficulties=NUM_ITEMS,

@@ -16,6 +16,12 @@ Arguments
 Metric
     ``success``: whether the exit was reached (success rate = mean over episodes).
 Version History
+    * v8 (2026-11-27): the released mazes' geometry and Doom's squares: inner
+      walls end at their grid lines, the outer wall's face is the maze's
+      edge; the agent block as squares aligned with the map and
+      items are touched within 0.28 m in x and y, as Doom tests things; the
+      tic the agent meets a wall it keeps only the rest of its move
+      (docs/motion.md, "Walls, squares and the impact tic").
     * v7 (2026-11-27): the agent slides along walls as Doom
       does: a tic a wall or a pillar stops it, it keeps 31/32 of the slid
       velocity (Doom's slide move), so it slides at 74% of the speed
@@ -96,7 +102,7 @@ class Labyrinth(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="labyrinth",
     task=Labyrinth,
-    gym_id="mjmaze/Labyrinth-v7",
+    gym_id="mjmaze/Labyrinth-v8",
     seed_code=1,
     difficulty="size",
     difficulties=SIZES,

@@ -36,6 +36,12 @@ Arguments
 Metric
     ``duration``: tics survived (max 2100); also ``health`` and ``totem_green``.
 Version History
+    * v9 (2026-11-27): the released mazes' geometry and Doom's squares: inner
+      walls end at their grid lines, the outer wall's face is the maze's
+      edge; the agent and the totem block as squares aligned with the map and
+      items are touched within 0.28 m in x and y, as Doom tests things; the
+      tic the agent meets a wall it keeps only the rest of its move
+      (docs/motion.md, "Walls, squares and the impact tic").
     * v8 (2026-11-27): the agent slides along walls as Doom
       does: a tic a wall or a pillar stops it, it keeps 31/32 of the slid
       velocity (Doom's slide move), so it slides at 74% of the speed
@@ -343,7 +349,7 @@ class TwoColour(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="two_colour",
     task=TwoColour,
-    gym_id="mjmaze/TwoColour-v8",
+    gym_id="mjmaze/TwoColour-v9",
     seed_code=4,
     difficulty="complexity",
     difficulties=COMPLEXITIES,
