@@ -4,6 +4,7 @@
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --agreement labyrinth_7   # the same action at the same pose? how far apart are the frames?
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --agreement two_colour_1  # ... with ViZDoom's items placed
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --picks two_colour_5      # right and wrong picks, both engines
+    python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --motion labyrinth_13     # each step from ViZDoom's state: where it lands
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --shift 1 --out F         # frames moved 1 px: the probe's scale
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --freedoom vizdoom --out F # ViZDoom's own Freedoom 0.13
 
@@ -289,6 +290,64 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
     return float(np.mean(same)), float(np.mean(same_shifted)), gap
 
 
+def motion(name: str, checkout: str, mazes: int = 8, wad: str | None = None) -> np.ndarray:
+    """How far mjmaze's motion lands from ViZDoom's, one agent step at a time, along the agent's own path.
+
+    The agent plays the first ``mazes`` test mazes greedily in ViZDoom; at
+    each step its pose, velocity and held turn are set in mjmaze, the same
+    action is stepped there, and the pose it reaches is compared with
+    ViZDoom's. Nothing accumulates: each step starts from ViZDoom's state.
+    Returns ``(steps, 3)``: the miss, ViZDoom's move and mjmaze's (map units).
+    """
+    import math
+
+    import vizdoom as vzd
+
+    import mjmaze
+
+    info = paper_agents.get(name)
+    _, agent, _ = paper_agents.load(name, paper_dir=checkout)
+    folder = pathlib.Path(checkout) / paper_agents.MAZES / info.maze_folder / "test"
+    env = mjmaze.load(info.scenario, task_kwargs={**info.task_kwargs, "layouts": str(folder), "head_bob": False})
+    task, physics = env.task, env.physics
+    per_tic = mjcf.MAP_UNIT / physics.model.opt.timestep  # map units a tic -> m/s
+    rows = []
+    for index in range(mazes):
+        maze = json.loads((folder / f"custom_scenario{index:03d}.json").read_text())
+        centre = np.mean(np.array(maze["exterior"], dtype=float), axis=0)
+        game = _game(folder / f"custom_scenario{index:03d}.cfg", seed=index, wad=wad)
+        variables = [getattr(vzd.GameVariable, v) for v in (*_POSE, "VELOCITY_X", "VELOCITY_Y")]
+        hidden, start = agent.initial_state(1), torch.ones(1, dtype=torch.bool)
+        path = []
+        while not game.is_episode_finished():
+            state = [game.get_game_variable(v) for v in variables]
+            with torch.no_grad():
+                logits, _, hidden = agent.step(agent.features(torch.from_numpy(_frame(game)[None])), hidden, start)
+            start[:] = False
+            action = int(logits.argmax())
+            game.make_action(LIMITED_ACTIONS[action], FRAME_SKIP)
+            if not game.is_episode_finished():
+                path.append((state, action, [game.get_game_variable(v) for v in variables[:2]]))
+        game.close()
+        env.reset()
+        while task.config.index != index:
+            env.reset()
+        held = 0  # tics a turn key has been held, as Doom counts them
+        for (x, y, angle, vx, vy), action, (next_x, next_y) in path:
+            physics.set_agent_pose(*_metres(x, y, centre), math.radians(angle))
+            physics.data.qvel[:2] = vx * per_tic, vy * per_tic
+            physics.turn_held = held
+            physics.command = task.actions[action]
+            physics.step(FRAME_SKIP)
+            held = (held + FRAME_SKIP) * (task.actions[action][1] != 0)
+            ours = np.array(physics.agent_pose()[:2]) / mjcf.MAP_UNIT
+            start_xy = np.array(_metres(x, y, centre)) / mjcf.MAP_UNIT
+            doom = np.array(_metres(next_x, next_y, centre)) / mjcf.MAP_UNIT
+            rows.append((np.hypot(*(ours - doom)), np.hypot(*(doom - start_xy)), np.hypot(*(ours - start_xy))))
+    task.close()
+    return np.array(rows)
+
+
 def frame_gaps(doom: np.ndarray, ours: np.ndarray, block: int = 8) -> tuple[float, float, float]:
     """Mean absolute grey difference of two ``(H, W, 3)`` frames: per pixel, in ``block`` x ``block`` means, per column."""
     a, b = (frame.astype(np.float64).mean(axis=2) for frame in (doom, ours))
@@ -431,7 +490,10 @@ def main() -> None:
     parser.add_argument("--agreement", metavar="SETTING", default=None,
                         help="instead: how often a Labyrinth or Two-colour agent acts alike on both engines' frames "
                              "at the same poses, and how far apart the engines' frames are there")
-    parser.add_argument("--mazes", type=int, default=8, help="test mazes for --agreement (default 8)")
+    parser.add_argument("--motion", metavar="SETTING", default=None,
+                        help="instead: how far mjmaze's step lands from ViZDoom's, from ViZDoom's state at each "
+                             "step of the agent's path")
+    parser.add_argument("--mazes", type=int, default=8, help="test mazes for --agreement and --motion (default 8)")
     parser.add_argument("--freedoom", default="paper", metavar="paper|vizdoom|PATH",
                         help="the game data: paper (default: Freedoom 0.10.1, as the paper's ViZDoom 1.1.4 had it; "
                              "fetched once), vizdoom (the installed ViZDoom's own), or a freedoom2.wad")
@@ -451,6 +513,16 @@ def main() -> None:
         if scenario == "two_colour":
             hidden = agreement(args.agreement, str(args.checkout), mazes=args.mazes, hide_items=True, wad=wad)[0]
             print(f"  with mjmaze's items hidden: {hidden:.1%}")
+        return
+    if args.motion:
+        if args.mazes < 1:
+            raise SystemExit(f"error: --mazes must be 1 or more, got {args.mazes}")
+        rows = motion(args.motion, str(args.checkout), mazes=args.mazes, wad=wad)
+        miss = rows[:, 0]
+        print(f"{args.motion}, {len(rows)} steps of the first {args.mazes} test mazes: mjmaze's step lands "
+              f"{miss.mean():.2f} map units from ViZDoom's on average (median {np.median(miss):.2f}, 99th "
+              f"percentile {np.percentile(miss, 99):.1f}); over 4 units at {(miss > 4).mean():.1%} of steps, over 16 "
+              f"at {(miss > 16).mean():.1%}; mean move ViZDoom {rows[:, 1].mean():.2f}, mjmaze {rows[:, 2].mean():.2f}")
         return
     if args.picks:
         try:
