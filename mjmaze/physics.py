@@ -88,7 +88,7 @@ class MazePhysics(mujoco.Physics):
                 vx, vy, yaw_rate, held = tic_motion(math, vx, vy, float(qpos[2]), forward, turn, held, dt)
                 qvel[0], qvel[1], qvel[2] = vx, vy, yaw_rate
                 thrust_vx, thrust_vy = vx, vy  # Doom's bob reads the velocity here
-                # Only x and y matter (the agent is a sphere).
+                # Only x and y matter (the agent's box rides the slide joints).
                 ahead_x, ahead_y = vx * dt, vy * dt
                 qpos[0] += ahead_x
                 qpos[1] += ahead_y

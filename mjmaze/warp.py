@@ -46,9 +46,10 @@ from mjmaze import batch, core, look, mjcf, physics, rules, suite, walls
 
 # Where a geom that must not be seen or touched in a world goes (below the floor).
 _AWAY_Z = -50.0
-# Contacts and constraint rows a world can hold: the agent (a sphere) touches
-# at most a corner's few wall boxes and a pillar at once.
-_CONTACTS_PER_WORLD = 16
+# Contacts and constraint rows a world can hold: the agent's box meets a wall
+# box or a pillar's in up to 4 points (a face's corners), and at most a
+# junction's four wall boxes and a pillar at once.
+_CONTACTS_PER_WORLD = 32
 
 
 def build_model(task: core.MazeRules) -> tuple[mujoco.MjModel, np.ndarray, np.ndarray]:
