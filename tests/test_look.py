@@ -11,7 +11,7 @@ import pytest
 
 import mjmaze
 
-from mjmaze import look, mjcf, palette, render, sprites, viz, walls
+from mjmaze import look, mjcf, palette, render, sprites, viz
 from mjmaze.tasks import base, find_return, labyrinth, two_colour
 
 from conftest import place
