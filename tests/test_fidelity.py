@@ -245,7 +245,7 @@ def test_an_item_is_within_reach_in_doom_s_square(offset, reached):
 
 
 def clearance_from_walls(config, xy):
-    """How far a square centred at each point can grow before it meets a wall (Doom's player is one)."""
+    """How far a square centred at each point can grow before it meets a wall (Doom tests things by squares)."""
     boxes = walls.wall_runs(config.h_walls, config.v_walls, config.cell_size)
     gap_x = np.abs(xy[:, None, 0] - boxes[:, 0]) - boxes[:, 2]
     gap_y = np.abs(xy[:, None, 1] - boxes[:, 1]) - boxes[:, 3]
@@ -259,8 +259,9 @@ def test_items_cover_the_floor_the_agent_can_stand_on():
         env.reset()
         task, config = env.task, env.task.config
         xy = task.item_xy[task.item_active]
-        assert (clearance_from_walls(config, xy) >= base.AGENT_RADIUS).all()
-        assert (np.abs(xy).max(axis=1) >= two_colour.TOTEM_CLEARANCE).all()  # the totem is at the origin
+        # Where the released script's Spawn succeeds: the armour's square clear of walls and the totem's.
+        assert (clearance_from_walls(config, xy) >= two_colour.ITEM_RADIUS).all()
+        assert (np.abs(xy).max(axis=1) >= two_colour.ITEM_TOTEM_CLEARANCE).all()  # the totem is at the origin
         # Within 0.25 m of a cell edge: 44% of a cell's area; the old rule gave 0%.
         offset = np.abs((xy + config.size * config.cell_size / 2) % config.cell_size - config.cell_size / 2)
         near_open_edge += int((offset.max(axis=1) > config.cell_size / 2 - 0.25).sum())

@@ -22,7 +22,7 @@ Version History
       edge; the agent and pillars block as squares aligned with the map and
       items are touched within 0.28 m in x and y, as Doom tests things; the
       tic the agent meets a wall it keeps only the rest of its move
-      (docs/motion.md, "Walls, squares and the impact tic").
+      (docs/motion.md, "Walls and squares").
     * v5 (2026-11-27): the agent slides along walls as Doom
       does: a tic a wall or a pillar stops it, it keeps 31/32 of the slid
       velocity (Doom's slide move), so it slides at 74% of the speed

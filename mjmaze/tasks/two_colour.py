@@ -5,18 +5,18 @@ Action Space
 Observation
     ``pixels``: uint8 RGB ``(64, 112, 3)``, no weapon (as every scenario).
 Rules
-    A tall totem at the maze centre is red or green, 50/50 per episode. 10 green
-    and 10 red items start at random positions, uniform over the floor the agent
-    can stand on (as released) and out of its reach; one more appears every 30
-    tics, colours alternating, with no cap (as released; at most 90 in an
-    episode, a fixed pool of 90 geoms). Health (cap 100) decays as the released
-    maze's floor takes it, Doom's hefty lava: 8 every 32 tics, the first hit
-    already taken at the first observation (health 92), the next 23 tics in,
-    as ViZDoom plays it. An item of the totem's colour gives +25; the other
-    colour takes 25 less what the armour just picked up absorbs: 17 for a
-    green item, 13 for a red one. **Decision**: the released decay and
-    damage, where the paper's spec reads 1 per agent step and 25
-    (README, "Decisions"); each hit flashes the view red
+    A tall totem at the maze centre is red or green, 50/50 per episode. 10
+    green and 10 red items start at random positions, uniform over the floor
+    where an armour fits (as the released script spawns them) and out of the
+    agent's reach; one more appears every 30 tics, colours alternating, with no
+    cap (as released; at most 90 in an episode, a fixed pool of 90 geoms).
+    Health (cap 100) decays as the released maze's floor takes it, Doom's hefty
+    lava: 8 every 32 tics, the first hit already taken at the first observation
+    (health 92), the next 23 tics in, as ViZDoom plays it. An item of the
+    totem's colour gives +25; the other colour takes 25 less what the armour
+    just picked up absorbs: 17 for a green item, 13 for a red one.
+    **Decision**: the released decay and damage, where the paper's spec reads 1
+    per agent step and 25 (README, "Decisions"); each hit flashes the view red
     (:func:`mjmaze.rules.flash`), every item gold.
 Rewards
     +0.01 per tic survived (+0.04 per agent step) and ``correct_item_reward``
@@ -41,7 +41,8 @@ Version History
       edge; the agent and the totem block as squares aligned with the map and
       items are touched within 0.28 m in x and y, as Doom tests things; the
       tic the agent meets a wall it keeps only the rest of its move
-      (docs/motion.md, "Walls, squares and the impact tic").
+      (docs/motion.md, "Walls and squares"); items appear where the released
+      script's Spawn succeeds, the armour's square clear of walls, totem and agent.
     * v8 (2026-11-27): the agent slides along walls as Doom
       does: a tic a wall or a pillar stops it, it keeps 31/32 of the slid
       velocity (Doom's slide move), so it slides at 74% of the speed
@@ -113,9 +114,11 @@ LAVA_FIRST_TIC = 23
 START_HEALTH = MAX_HEALTH - LAVA_DAMAGE
 SURVIVAL_REWARD = 0.01 * core.TICS_PER_STEP
 CORRECT_ITEM_REWARD = 1.0
-# Items appear uniformly where the agent can stand: its square clear of every
-# wall and of the totem's square, and out of the agent's reach.
-ITEM_WALL_CLEARANCE = core.AGENT_RADIUS
+# Items appear uniformly where the released script's Spawn succeeds (it retries
+# until one does): the armour's square (Doom's radius 20 map units) clear of
+# every wall and of the solid totem's and agent's squares (so out of reach).
+ITEM_RADIUS = 20 * mjcf.MAP_UNIT
+ITEM_WALL_CLEARANCE = ITEM_RADIUS
 # Points tried per item, the first free one kept (see TwoColour._free_positions):
 # a point lands on free floor with probability >= 0.79 (complexity 10, the
 # most walls, measured over generated mazes), so all 32 miss with probability
@@ -137,6 +140,7 @@ TOTEM = mjcf.floor_thing("totem", "cylinder", 32, 52, RED, collides=True)
 TOTEM_RADIUS = TOTEM.size[0]
 # The agent's centre never comes closer to the totem's than this in x and in y (both squares).
 TOTEM_CLEARANCE = TOTEM_RADIUS + core.AGENT_RADIUS
+ITEM_TOTEM_CLEARANCE = TOTEM_RADIUS + ITEM_RADIUS
 # Where the released map keeps the columns until its script moves one in
 # (4,096 map units west of the centre), and an absent totem stays.
 TOTEM_PARKED_XY = (-4096 * mjcf.MAP_UNIT, 0.0)
@@ -271,7 +275,7 @@ class TwoColour(core.MazeRules):
         return xp.where(dead, reward, reward + SURVIVAL_REWARD), dead
 
     def _free_positions(self, xp, state, keys, items, agent_xy):
-        """Where items ``items`` ``(B, K)`` appear: uniform over the floor the agent can stand on, out of its reach.
+        """Where items ``items`` ``(B, K)`` appear: uniform over the floor where an armour fits, out of the agent's reach.
 
         Each item tries :data:`ITEM_CANDIDATES` points drawn from the episode's
         key (``keys`` ``(B,)``) and the item's index and keeps the first that is free; returns
@@ -297,7 +301,7 @@ class TwoColour(core.MazeRules):
             gap_y = xp.abs(points[..., 1:2] - boxes[..., 1]) - boxes[..., 3]
             free = (
                 (xp.min(xp.maximum(gap_x, gap_y), axis=-1) >= ITEM_WALL_CLEARANCE)
-                & (xp.max(xp.abs(points - totem_xy), axis=-1) >= TOTEM_CLEARANCE)
+                & (xp.max(xp.abs(points - totem_xy), axis=-1) >= ITEM_TOTEM_CLEARANCE)
                 & (xp.max(xp.abs(points - agent_xy[:, None, None, :]), axis=-1) >= core.PICKUP_RADIUS)
             )
             first = candidate[..., 0] == xp.argmax(xp.astype(free, xp.int8), axis=-1)[..., None]  # (B, k, candidates)
