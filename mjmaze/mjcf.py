@@ -38,7 +38,7 @@ MAP_UNIT = 1 / 128  # metres per Doom map unit (a 128-unit cell is 1 m)
 EGO_CAMERA = "ego"  # the agent's eye (xml_templates/arena.xml)
 VISIBLE_GROUP = 1  # the geom group of an object the agent sees (mjmaze.render.HIDDEN_GROUP: one it does not)
 ARENA_BODY = "arena"  # build_xml's batch arena: the body holding what differs between worlds
-COLLISION_SUFFIX = "_collision"  # build_xml's batch arena: a colliding object's blocking twin
+COLLISION_SUFFIX = "_collision"  # a colliding object's blocking twin (build_xml's _blocking_square)
 OVERHEAD_CAMERA = "overhead"
 OVERHEAD_HEIGHT = 10.0
 CEILING_GROUP = 2  # a geom group drawn in the agent's view, left out of top-down maps (mjmaze.render)
@@ -49,8 +49,9 @@ EYE_HEIGHT = 0.32  # the ego camera's height (xml_templates/arena.xml)
 class ObjectGeom:
     """A scenario object added to the arena (an item, a pillar, the totem).
 
-    An object that ``collides`` is a geom in a mocap body of the same name,
-    placed per episode by writing ``data.mocap_pos`` (a body of its own, because
+    An object that ``collides`` is a geom in a mocap body of the same name
+    (it blocks by a box twin, :func:`_blocking_square`), placed per episode by
+    writing ``data.mocap_pos`` (a body of its own, because
     MuJoCo's midphase keeps the world body's geom bounds from compile time: a
     colliding world geom could not move). Any other object is a world geom,
     placed by writing ``model.geom_pos``: a body each made every ``mj_step``

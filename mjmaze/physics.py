@@ -105,6 +105,7 @@ class MazePhysics(mujoco.Physics):
                     # along it, and keeps as velocity only that rest (ZDoom's FSlide::SlideMove): the
                     # share of the tic spent reaching the wall, at least its 1/32 fudge, is lost.
                     closing = slid_x * dx + slid_y * dy  # the part of the move into the wall that was left
+                    # (a contact that pushed the agent out, closing <= -stopped, keeps the steady 31/32)
                     reached = min(max(closing / max(closing + stopped, _BLOCKED_SQ), 1 - SLIDE_KEEP), 1.0)
                     keep = FRICTION * (1.0 - reached)
                 else:
