@@ -266,9 +266,7 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
                     flashes[1] += rules.BONUS_TICS
                 health = now
         game.close()
-        env.reset()
-        while task.config.index != index:
-            env.reset()
+        _reset_to(env, index)
         hidden, start = agent.initial_state(1), torch.ones(1, dtype=torch.bool)
         shifted_hidden = agent.initial_state(1)
         for x, y, yaw, action, things, flashes, doom, shifted in path:
@@ -329,9 +327,7 @@ def motion(name: str, checkout: str, mazes: int = 8, wad: str | None = None) -> 
             if not game.is_episode_finished():
                 path.append((state, action, [game.get_game_variable(v) for v in variables[:2]]))
         game.close()
-        env.reset()
-        while task.config.index != index:
-            env.reset()
+        _reset_to(env, index)
         held = 0  # tics a turn key has been held, as Doom counts them
         for (x, y, angle, vx, vy), action, (next_x, next_y) in path:
             physics.set_agent_pose(*_metres(x, y, centre), math.radians(angle))
@@ -431,6 +427,13 @@ def picks(name: str, checkout: str, mazes: int = 32, wad: str | None = None) -> 
                                "wrong": 100 * sum(e[3] for e in chosen) / tics}
         table[engine] = rows
     return table
+
+
+def _reset_to(env, index: int) -> None:
+    """Resets a ``layouts=`` env until it plays configuration (released maze) ``index``."""
+    env.reset()
+    while env.task.config.index != index:
+        env.reset()
 
 
 def _metres(x: float, y: float, centre: np.ndarray) -> tuple[float, float]:

@@ -118,7 +118,6 @@ CORRECT_ITEM_REWARD = 1.0
 # until one does): the armour's square (Doom's radius 20 map units) clear of
 # every wall and of the solid totem's and agent's squares (so out of reach).
 ITEM_RADIUS = 20 * mjcf.MAP_UNIT
-ITEM_WALL_CLEARANCE = ITEM_RADIUS
 # Points tried per item, the first free one kept (see TwoColour._free_positions):
 # a point lands on free floor with probability >= 0.79 (complexity 10, the
 # most walls, measured over generated mazes), so all 32 miss with probability
@@ -296,11 +295,11 @@ class TwoColour(core.MazeRules):
             part = items[:, begin : begin + chunk]
             u = rules.uniform(xp, keys[:, None, None, None], rules.DRAW_ITEM, part[:, :, None, None], candidate, axis)
             points = (2 * u - 1) * half  # (B, k, candidates, 2)
-            # The agent's square fits beside a wall box where it is clear of it in x or in y.
+            # An armour's square fits beside a wall box where it is clear of it in x or in y.
             gap_x = xp.abs(points[..., 0:1] - boxes[..., 0]) - boxes[..., 2]
             gap_y = xp.abs(points[..., 1:2] - boxes[..., 1]) - boxes[..., 3]
             free = (
-                (xp.min(xp.maximum(gap_x, gap_y), axis=-1) >= ITEM_WALL_CLEARANCE)
+                (xp.min(xp.maximum(gap_x, gap_y), axis=-1) >= ITEM_RADIUS)
                 & (xp.max(xp.abs(points - totem_xy), axis=-1) >= ITEM_TOTEM_CLEARANCE)
                 & (xp.max(xp.abs(points - agent_xy[:, None, None, :]), axis=-1) >= core.PICKUP_RADIUS)
             )
