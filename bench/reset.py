@@ -19,7 +19,7 @@ import time
 import mujoco
 
 import mjmaze
-from mjmaze import configs, mjcf, render, walls
+from mjmaze import configs, core, mjcf, render, walls
 from mjmaze.tasks import labyrinth
 
 
@@ -58,7 +58,7 @@ def main() -> None:
     pool_ms = 1e3 * (time.perf_counter() - start) / n
     pool_mb = rss_mb() - before
 
-    xml = mjcf.build_xml(size, labyrinth.CELL_SIZE, labyrinth.Labyrinth.objects)
+    xml = mjcf.build_xml(size, labyrinth.CELL_SIZE, labyrinth.Labyrinth.objects, width=core.DEFAULT_WIDTH)
     before = rss_mb()
     start = time.perf_counter()
     cache = []

@@ -105,7 +105,7 @@ def draw_pistol(xp, frames, dx, dy) -> None:
 
 class SpriteView:
     """Doom's sprites in a frame: each item's picture turned to face the camera, at its animation
-    frame, averaged as the released frames average it at its depth (:func:`mjmaze.sprites.textures`).
+    frame, lit and averaged as ViZDoom's released frames show it at its depth (:func:`mjmaze.sprites.textures`).
 
     Made once per model (its sprite geoms, :func:`mjmaze.mjcf.sprite_geoms`)
     and frame width, on numpy or torch (``xp``, as :mod:`mjmaze.rules`); call
@@ -122,25 +122,22 @@ class SpriteView:
         kinds = list(dict.fromkeys(of_geom))
         # Every kind's animation repeats within the least common multiple of their cycles.
         self._cycle = math.lcm(*(sum(t for _, t, _ in kind.frames) for kind in kinds)) if kinds else 1
-        levels = len(sprites.BOX_SIZES)
-        table = np.zeros((max(len(kinds), 1), self._cycle, levels), dtype=np.int64)  # (kind, tic, level) -> material
+        # A sprite shows the material of its animation frame and its depth's bin (one colormap, one
+        # averaging square: sprites.depth_bins).
+        bins = sprites.depth_bins(mjcf.unit_depth(width))
+        self._bins = len(bins.depth)
+        table = np.zeros((max(len(kinds), 1), self._cycle, self._bins), dtype=np.int64)  # (kind, tic, bin) -> material
         for k, kind in enumerate(kinds):
             frames = sprites.frame_of_tic(kind, self._cycle)
-            for level in range(levels):
-                ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MATERIAL, mjcf.sprite_material(kind, f, level))
+            for depth_bin in range(self._bins):
+                ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MATERIAL, mjcf.sprite_material(kind, f, depth_bin))
                        for f in range(len(kind.frames))]
-                table[k, :, level] = np.array(ids)[frames]
+                table[k, :, depth_bin] = np.array(ids)[frames]
         self._materials = xp.asarray(table.reshape(-1), device=device)
-        self._levels = levels
         # Where each geom's kind starts in the flat table.
-        self._first = xp.asarray(np.array([kinds.index(s) * self._cycle * levels for s in of_geom], dtype=np.int64),
+        self._first = xp.asarray(np.array([kinds.index(s) * self._cycle * self._bins for s in of_geom], dtype=np.int64),
                                  device=device)
-        # A frame pixel spans depth / (focal length in pixels) metres, each sprite pixel a map unit:
-        # it covers depth / (focal x MAP_UNIT) sprite pixels. The level shown is the one whose square
-        # is nearest (geometrically) to that, found among the depths where the nearest one changes.
-        boxes = np.array(sprites.BOX_SIZES, dtype=np.float64)
-        depths = np.sqrt(boxes[:-1] * boxes[1:]) * mjcf.DOOM_FOCAL_ACROSS * width * mjcf.MAP_UNIT
-        self._level_depths = xp.asarray(depths, device=device)
+        self._bin_edges = xp.asarray(bins.edges, device=device)
 
     def __len__(self) -> int:
         return len(self.geom_ids)
@@ -155,8 +152,8 @@ class SpriteView:
         quat = xp.stack([xp.cos(half), zero, zero, xp.sin(half)], axis=-1)  # turned to the camera's heading
         offset = sprite_xy - eye_xy[:, None, :]
         depth = offset[..., 0] * xp.cos(yaw)[:, None] + offset[..., 1] * xp.sin(yaw)[:, None]
-        level = xp.searchsorted(self._level_depths, xp.astype(depth, self._level_depths.dtype))
-        index = self._first + (xp.astype(tics, xp.int64)[:, None] % self._cycle) * self._levels + level
+        depth_bin = xp.searchsorted(self._bin_edges, xp.astype(depth, self._bin_edges.dtype))
+        index = self._first + (xp.astype(tics, xp.int64)[:, None] % self._cycle) * self._bins + depth_bin
         return xp.reshape(xp.take(self._materials, xp.reshape(index, (-1,)), axis=0), index.shape), quat
 
 

@@ -116,9 +116,10 @@ def overhead_extent(grid_size: int, cell_size: float) -> float:
 
 def build_xml(
     grid_size: int, cell_size: float, objects: Sequence[ObjectGeom] = (), visual_style: str = "textured",
-    room: palette.Room = palette.STONE_ROOM, wall_layout_quads: Sequence[int] | None = None,
+    room: palette.Room = palette.STONE_ROOM, wall_layout_quads: Sequence[int] | None = None, *, width: int,
 ) -> str:
-    """The MJCF of an arena for ``grid_size x grid_size`` cells of ``cell_size`` metres, coloured as ``room``.
+    """The MJCF of an arena for ``grid_size x grid_size`` cells of ``cell_size`` metres, coloured as ``room``,
+    for ``width``-wide frames (the sprites' depth bins depend on it).
 
     A ``"textured"`` model needs :func:`paint_textures` after compiling.
 
@@ -194,7 +195,7 @@ def build_xml(
         rgba = obj.rgba
         attrs = dict(name=obj.name, type=obj.type, size=" ".join(map(str, obj.size)))
         if obj.sprite is not None and visual_style == "textured":
-            attrs, rgba = _add_sprite(asset, obj)
+            attrs, rgba = _add_sprite(asset, obj, width)
         attrs["rgba"] = " ".join(map(str, rgba))
         if batch and obj.collides:
             colliding.append((obj, attrs))
@@ -285,13 +286,13 @@ def _ambient_light(root: ET.Element) -> None:
     headlight.set("diffuse", "0 0 0")
 
 
-def paint_textures(model: mujoco.MjModel, objects: Sequence[ObjectGeom] = ()) -> None:
+def paint_textures(model: mujoco.MjModel, objects: Sequence[ObjectGeom], width: int) -> None:
     """Fills the textures of a ``"textured"`` model: walls and floor (a fixed
     pattern, the same everywhere), and the pictures and meshes of ``objects``'
-    sprites (:func:`write_sprites`)."""
+    sprites for ``width``-wide frames (:func:`write_sprites`)."""
     for name, texels in (("wall", palette.brick_texels()), ("floor", palette.tile_texels())):
         _paint(model, name, texels)
-    write_sprites(model, objects)
+    write_sprites(model, objects, width)
 
 
 def _paint(model: mujoco.MjModel, texture_name: str, texels: np.ndarray) -> None:
@@ -305,20 +306,27 @@ def _sprite_asset(sprite: sprites.Sprite) -> str:
     return f"sprite_{sprite.name}"
 
 
-def sprite_material(sprite: sprites.Sprite, frame: int, level: int) -> str:
-    """The material (and texture) of ``sprite``'s animation frame ``frame`` averaged at level ``level``."""
-    return f"{_sprite_asset(sprite)}_{frame}_{level}"
+def sprite_material(sprite: sprites.Sprite, frame: int, depth_bin: int) -> str:
+    """The material (and texture) of ``sprite``'s animation frame ``frame`` in depth bin ``depth_bin``
+    (:func:`mjmaze.sprites.depth_bins`)."""
+    return f"{_sprite_asset(sprite)}_{frame}_{depth_bin}"
 
 
-def _add_sprite(asset: ET.Element, obj: ObjectGeom) -> tuple[dict, tuple]:
-    """The mesh, textures and materials of ``obj``'s sprite (once per sprite); ``(geom attributes, rgba)``.
+def unit_depth(width: int) -> float:
+    """Metres ahead at which a sprite pixel (a map unit) spans one pixel of a ``width``-wide frame."""
+    return DOOM_FOCAL_ACROSS * width * MAP_UNIT
 
-    A texture and a material per animation frame and averaging level
+
+def _add_sprite(asset: ET.Element, obj: ObjectGeom, width: int) -> tuple[dict, tuple]:
+    """The mesh, textures and materials of ``obj``'s sprite (once per sprite) for ``width``-wide
+    frames; ``(geom attributes, rgba)``.
+
+    A texture and a material per animation frame and depth bin
     (:func:`mjmaze.sprites.textures`); GL draws a texel ``texel x (AMBIENT +
     emission)`` before Doom's light, the geom's colour white.
     """
     name = _sprite_asset(obj.sprite)
-    texels, emission = sprites.textures(obj.sprite)
+    texels, emission = sprites.textures(obj.sprite, unit_depth(width))
     if asset.find(f"mesh[@name='{name}']") is None:
         # Compiled from the quads nudged apart (the compiler merges no vertex
         # and finds a volume), recentred by it: write_sprites writes them as they are.
@@ -330,18 +338,20 @@ def _add_sprite(asset: ET.Element, obj: ObjectGeom) -> tuple[dict, tuple]:
                       face=" ".join(map(str, faces.ravel())),
                       texcoord=" ".join(f"{v:.5f}" for v in texcoords.ravel()))
         for frame in range(texels.shape[0]):
-            for level in range(texels.shape[1]):
-                material = sprite_material(obj.sprite, frame, level)
+            for depth_bin in range(texels.shape[1]):
+                material = sprite_material(obj.sprite, frame, depth_bin)
                 ET.SubElement(asset, "texture", name=material, type="2d", builtin="flat",
                               width=str(texels.shape[3]), height=str(texels.shape[2]), rgb1="1 1 1")
-                ET.SubElement(asset, "material", name=material, texture=material, emission=f"{emission[frame]:.4f}",
+                ET.SubElement(asset, "material", name=material, texture=material,
+                              emission=f"{emission[frame, depth_bin]:.4f}",
                               specular="0", shininess="0", reflectance="0")
     return (dict(name=obj.name, type="mesh", mesh=name, material=sprite_material(obj.sprite, 0, 0)),
             (1.0, 1.0, 1.0, 1.0))
 
 
-def write_sprites(model: mujoco.MjModel, objects: Sequence[ObjectGeom]) -> None:
-    """Writes the pictures and meshes of ``objects``' sprites into a compiled textured model.
+def write_sprites(model: mujoco.MjModel, objects: Sequence[ObjectGeom], width: int) -> None:
+    """Writes the pictures and meshes of ``objects``' sprites into a compiled textured model
+    for ``width``-wide frames.
 
     A mesh's vertices are written as :func:`mjmaze.sprites.mesh_quads` gives
     them, in the frame of a geom at the object's height (``z``), unrotated
@@ -357,10 +367,10 @@ def write_sprites(model: mujoco.MjModel, objects: Sequence[ObjectGeom]) -> None:
         if obj.sprite in written:
             continue
         written.add(obj.sprite)
-        texels, _ = sprites.textures(obj.sprite)
+        texels, _ = sprites.textures(obj.sprite, unit_depth(width))
         for frame in range(texels.shape[0]):
-            for level in range(texels.shape[1]):
-                _paint(model, sprite_material(obj.sprite, frame, level), texels[frame, level])
+            for depth_bin in range(texels.shape[1]):
+                _paint(model, sprite_material(obj.sprite, frame, depth_bin), texels[frame, depth_bin])
         mesh = model.geom_dataid[geom]
         verts, texcoords = sprites.mesh_quads(obj.sprite, obj.z, MAP_UNIT)
         verts, texcoords = verts.reshape(-1, 3), texcoords.reshape(-1, 2)

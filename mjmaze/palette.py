@@ -99,17 +99,6 @@ CEILING_LIGHT = DepthLight(
 _THING_GREY = tuple((north_south + east_west) / 2
                     for north_south, east_west in zip(NORTH_SOUTH_WALL_LIGHT.grey, EAST_WEST_WALL_LIGHT.grey))
 THING_LIGHT = DepthLight(_WALL_DEPTHS, _THING_GREY, 19.0)
-#: Freedoom's sprites (:mod:`mjmaze.sprites`) before Doom's light: GL draws a
-#: sector-lit pixel of palette colour ``P`` (0-1) as ``SPRITE_LIT x P``. The
-#: tall columns' calibrated colours above, drawn ``rgba x AMBIENT``, are their
-#: pictures' (``COL1A0``, ``COL3A0``) mean palette colours times 0.39 in every
-#: channel (green (17, 36, 12) over (44, 92, 34), red 52 over 133).
-SPRITE_LIT = 0.39
-#: A fullbright pixel (the armours' and keycards' blink, the soulsphere):
-#: Doom draws its palette colour whatever the depth; mjmaze's light scales
-#: with depth, so it is drawn as bright as Doom's 2.5 m ahead (over 1-2.5 m
-#: the soulsphere, all fullbright, is then within 16% of ViZDoom's; docs/look.md).
-SPRITE_FULLBRIGHT = float(1 / THING_LIGHT.gain(np.array(2.5)))
 TEXTURE_TEXELS = 64  # per side of a texture; one texture covers 1 m x 1 m
 # 1 / the mean grey of each texture (see _brick_texels, _tile_texels).
 TEXTURE_GAIN = {"wall": 1.35, "floor": 1.6}

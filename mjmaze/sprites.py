@@ -6,12 +6,13 @@ detail (docs/paper_agents.md: the K-item 4 agent took the right first item
 2 times in 64 with one-colour stand-ins, 62 with these pictures).
 
 ``freedoom/sprites.wad`` holds those pictures unchanged, in Doom's own patch
-format with its palette, taken from Freedoom 0.10.1's ``freedoom2.wad`` by
-``tools/freedoom_sprites.py`` (BSD licence: ``freedoom/COPYING``). A
-:class:`Sprite` is one Doom thing's animation; :func:`texture` turns it into
-what mjmaze draws: one picture, the animation's average as Doom lights it,
-on a flat mesh that turns to face the camera every frame
-(:func:`mjmaze.mjcf.build_xml`, :func:`mesh_quads`).
+format with its palette and colormaps (Doom's light), taken from Freedoom
+0.10.1's ``freedoom2.wad`` by ``tools/freedoom_sprites.py`` (BSD licence:
+``freedoom/COPYING``). A :class:`Sprite` is one Doom thing's animation;
+:func:`textures` turns it into what mjmaze draws: each animation frame per
+depth bin, lit through Doom's colormap there and averaged as the released
+frames average it, on a flat mesh that turns to face the camera every frame
+(:func:`mjmaze.mjcf.build_xml`, :func:`mesh_quads`, :class:`mjmaze.look.SpriteView`).
 """
 
 from __future__ import annotations
@@ -29,6 +30,18 @@ SPRITE_WAD = "sprites.wad"
 #: Pictures per animation frame: the picture averaged over a square of this many pixels around
 #: each pixel (:func:`textures`), for a frame pixel that covers about as many.
 BOX_SIZES = (1, 2, 3, 4, 6, 8, 12)
+#: Doom's light on a sector-lit sprite, as ZDoom's software renderer (which ViZDoom runs) draws
+#: it: colormap ``floor(SPRITE_SHADE - SPRITE_VISIBILITY / depth)`` of ``NUM_COLORMAPS``, depth
+#: in metres. ``SPRITE_SHADE`` is ZDoom's LIGHT2SHADE of the released sectors' light level, 160;
+#: ``SPRITE_VISIBILITY`` fits ViZDoom's frames (the armours', medikit's and keycards' sector-lit
+#: pictures 0.5-5 m ahead, ``python tools/doom_frames.py --sprite-light``; docs/look.md). Its
+#: colormaps darken a colour toward the palette's browns, not in proportion: Freedoom's red armour
+#: 4 m ahead is (41, 32, 26) in ViZDoom, where scaling its colours would give (50, 27, 28).
+NUM_COLORMAPS = 32
+SPRITE_SHADE = 21
+SPRITE_VISIBILITY = 10.0
+#: Metres ahead at which a map or the flat style's cylinder shows a sprite's colours (:func:`mean_colour`).
+MEAN_COLOUR_DEPTH = 2.0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -46,7 +59,7 @@ class Sprite:
 
 # ZDoom's DECORATE of the released items, which ViZDoom plays (thing types in docs/objects.md).
 GREEN_ARMOUR = Sprite("ARM1", (("A", 6, False), ("B", 7, True)))  # 2018
-BLUE_ARMOUR = Sprite("ARM2", (("A", 6, False), ("B", 7, True)))  # 2019, red in Freedoom
+BLUE_ARMOUR = Sprite("ARM2", (("A", 6, False), ("B", 6, True)))  # 2019, red in Freedoom; its blink is 6 + 6 tics
 MEDIKIT = Sprite("MEDI", (("A", 1, False),))  # 2012
 SOULSPHERE = Sprite("SOUL", tuple((f, 6, True) for f in "ABCDCB"))  # 2013, blue in Freedoom 0.10.1
 RED_KEYCARD = Sprite("RKEY", (("A", 10, False), ("B", 10, True)))  # 13
@@ -78,8 +91,8 @@ def write_wad(lumps: dict[str, bytes]) -> bytes:
     return b"PWAD" + struct.pack("<ii", len(lumps), offset) + body + directory
 
 
-def decode_patch(lump: bytes, playpal: bytes) -> tuple[np.ndarray, np.ndarray, tuple[int, int]]:
-    """A Doom picture: ``(rgb (h, w, 3) uint8, opaque (h, w) bool, (left offset, top offset))``.
+def decode_patch(lump: bytes) -> tuple[np.ndarray, np.ndarray, tuple[int, int]]:
+    """A Doom picture: ``(palette indices (h, w) uint8, opaque (h, w) bool, (left offset, top offset))``.
 
     Doom's patch format: a header, then per column its runs ("posts") of
     palette indices; the offsets place the picture's origin (the thing's
@@ -87,7 +100,6 @@ def decode_patch(lump: bytes, playpal: bytes) -> tuple[np.ndarray, np.ndarray, t
     below its top.
     """
     width, height, left, top = struct.unpack("<hhhh", lump[:8])
-    colours = np.frombuffer(playpal[:768], dtype=np.uint8).reshape(256, 3)
     indices = np.zeros((height, width), dtype=np.uint8)
     opaque = np.zeros((height, width), dtype=bool)
     for x, start in enumerate(struct.unpack(f"<{width}i", lump[8 : 8 + 4 * width])):
@@ -96,7 +108,7 @@ def decode_patch(lump: bytes, playpal: bytes) -> tuple[np.ndarray, np.ndarray, t
             indices[row : row + length, x] = np.frombuffer(lump, np.uint8, length, start + 3)
             opaque[row : row + length, x] = True
             start += length + 4
-    return colours[indices], opaque, (left, top)
+    return indices, opaque, (left, top)
 
 
 @functools.lru_cache(maxsize=None)
@@ -104,12 +116,18 @@ def _lumps() -> dict[str, bytes]:
     return read_wad(importlib.resources.files("mjmaze").joinpath("freedoom", SPRITE_WAD).read_bytes())
 
 
-def picture(name: str) -> tuple[np.ndarray, np.ndarray, tuple[int, int]]:
+def picture_indices(name: str) -> tuple[np.ndarray, np.ndarray, tuple[int, int]]:
     """Picture ``name`` (``"ARM1A0"``) of ``freedoom/sprites.wad``, decoded (:func:`decode_patch`)."""
     lumps = _lumps()
     if name not in lumps:
         raise KeyError(f"freedoom/{SPRITE_WAD} has no picture {name!r}; rebuild it with tools/freedoom_sprites.py")
-    return decode_patch(lumps[name], lumps["PLAYPAL"])
+    return decode_patch(lumps[name])
+
+
+def picture(name: str) -> tuple[np.ndarray, np.ndarray, tuple[int, int]]:
+    """Picture ``name`` in its palette colours: ``(rgb (h, w, 3) uint8, opaque, offsets)``."""
+    indices, opaque, offsets = picture_indices(name)
+    return palette_colours()[indices], opaque, offsets
 
 
 def shape(sprite: Sprite) -> tuple[np.ndarray, tuple[int, int]]:
@@ -125,11 +143,61 @@ def shape(sprite: Sprite) -> tuple[np.ndarray, tuple[int, int]]:
     return opaque_any, first
 
 
-def _unlit(sprite: Sprite, frame: int) -> np.ndarray:
-    """Frame ``frame``'s colours (0-1) as GL must draw them before Doom's light (see :func:`textures`)."""
+def palette_colours() -> np.ndarray:
+    """Doom's palette, ``(256, 3)`` uint8 (Freedoom 0.10.1's ``PLAYPAL``, its first)."""
+    return np.frombuffer(_lumps()["PLAYPAL"][:768], np.uint8).reshape(256, 3)
+
+
+@functools.lru_cache(maxsize=None)
+def colormaps() -> np.ndarray:
+    """Doom's light, ``(NUM_COLORMAPS, 256)`` palette indices: colormap ``c`` draws index ``p`` as
+    ``colormaps()[c, p]`` (0 the brightest; Freedoom 0.10.1's ``COLORMAP``)."""
+    return np.frombuffer(_lumps()["COLORMAP"], np.uint8)[: NUM_COLORMAPS * 256].reshape(NUM_COLORMAPS, 256)
+
+
+def colormap_of_depth(depth: np.ndarray) -> np.ndarray:
+    """The colormap Doom lights a sector-lit sprite with, ``depth`` metres ahead (along the view axis)."""
+    shade = SPRITE_SHADE - SPRITE_VISIBILITY / np.maximum(depth, 1e-9)
+    return np.clip(np.floor(shade), 0, NUM_COLORMAPS - 1).astype(np.int64)
+
+
+@dataclasses.dataclass(frozen=True)
+class DepthBins:
+    """Depth ranges over which Doom draws a sprite alike: one colormap, one averaging square.
+
+    ``edges`` (metres, increasing) split depth into ``len(edges) + 1`` bins; bin ``k`` shows
+    the picture averaged over ``BOX_SIZES[box[k]]`` pixels, lit as ``depth[k]`` ahead (its
+    middle, in one colormap), before mjmaze's light on things (:data:`mjmaze.palette.THING_LIGHT`).
+    """
+
+    edges: np.ndarray
+    box: tuple[int, ...]
+    depth: tuple[float, ...]
+
+
+@functools.lru_cache(maxsize=None)
+def depth_bins(unit_depth: float) -> DepthBins:
+    """The bins for frames where a sprite pixel (a map unit) ``unit_depth`` metres ahead spans
+    one frame pixel (:func:`mjmaze.mjcf.unit_depth`), ``unit_depth / depth`` of them ``depth`` ahead."""
+    boxes = np.array(BOX_SIZES, dtype=np.float64)
+    # A frame pixel covers depth / unit_depth sprite pixels: the nearest square (geometrically).
+    box_edges = np.sqrt(boxes[:-1] * boxes[1:]) * unit_depth
+    # The colormap steps where SHADE - VISIBILITY / depth crosses a whole number.
+    light_edges = SPRITE_VISIBILITY / (SPRITE_SHADE - np.arange(1, SPRITE_SHADE))
+    edges = np.unique(np.concatenate([box_edges, light_edges]))
+    middles = np.concatenate([[edges[0] * 0.75], np.sqrt(edges[:-1] * edges[1:]), [edges[-1] * 1.5]])
+    box = np.searchsorted(box_edges, middles)
+    return DepthBins(edges, tuple(int(b) for b in box), tuple(float(d) for d in middles))
+
+
+def lit_picture(sprite: Sprite, frame: int, depth: float) -> np.ndarray:
+    """Frame ``frame`` of ``sprite`` as Doom draws it ``depth`` metres ahead: ``(h, w, 3)`` uint8,
+    its palette colours through the depth's colormap (:func:`colormap_of_depth`), a fullbright
+    frame's through colormap 0 (unlit) at any depth."""
     letter, _, bright = sprite.frames[frame]
-    rgb, _, _ = picture(f"{sprite.name}{letter}0")
-    return rgb / 255.0 * (palette.SPRITE_FULLBRIGHT if bright else palette.SPRITE_LIT)
+    indices, _, _ = picture_indices(f"{sprite.name}{letter}0")
+    colormap = 0 if bright else int(colormap_of_depth(np.array(depth)))
+    return palette_colours()[colormaps()[colormap][indices]]
 
 
 def _box_mean(colour: np.ndarray, opaque: np.ndarray, box: int) -> np.ndarray:
@@ -150,43 +218,48 @@ def _box_mean(colour: np.ndarray, opaque: np.ndarray, box: int) -> np.ndarray:
 
 
 @functools.lru_cache(maxsize=None)
-def textures(sprite: Sprite) -> tuple[np.ndarray, np.ndarray]:
-    """What mjmaze draws of ``sprite``: ``(texels (frames, len(BOX_SIZES), h, w, 3) uint8, emission (frames,))``.
+def textures(sprite: Sprite, unit_depth: float) -> tuple[np.ndarray, np.ndarray]:
+    """What mjmaze draws of ``sprite``: ``(texels (frames, bins, h, w, 3) uint8, emission (frames, bins))``.
 
-    Per animation frame, its colours as GL must draw them before Doom's light
-    (:class:`mjmaze.look.DoomLight`): a sector-lit frame's palette colours
-    times :data:`mjmaze.palette.SPRITE_LIT`, a fullbright one's times
-    :data:`mjmaze.palette.SPRITE_FULLBRIGHT`. GL draws a texel ``texel x
-    (AMBIENT + emission)``: texels are the colours over ``AMBIENT + emission``,
-    the emission what the brightest channel needs beyond ``AMBIENT``.
+    Per animation frame and depth bin (:func:`depth_bins` of ``unit_depth``), the frame's
+    colours as Doom lights them there (:func:`lit_picture`: its colormap; a fullbright frame's
+    palette colours whatever the depth), over the light mjmaze applies to things after
+    (:class:`mjmaze.look.DoomLight`). GL draws a texel ``texel x (AMBIENT + emission)``:
+    texels are the colours over ``AMBIENT + emission``, the emission what the brightest
+    channel needs beyond ``AMBIENT``.
 
-    Level ``k`` of a frame is the picture averaged, at each pixel, over the
-    opaque pixels of the ``BOX_SIZES[k]``-wide square around it, as the
-    released frames average a sprite that 320x180 pixels drew into 112x64
-    (``cv2.INTER_AREA``: a frame pixel is the mean of the sprite under it):
-    :class:`mjmaze.look.SpriteView` shows each sprite the level of its depth,
-    and GL's nearest texel is then that mean. Transparent texels take the
-    frame's mean colour (only the mesh's edges could sample them).
+    The picture is averaged, at each pixel, over the opaque pixels of the
+    bin's square (``BOX_SIZES``) around it, as the released frames average a
+    sprite that 320x180 pixels drew into 112x64 (``cv2.INTER_AREA``: a frame
+    pixel is the mean of the sprite under it): :class:`mjmaze.look.SpriteView`
+    shows each sprite its depth's bin, and GL's nearest texel is then that mean.
+    Transparent texels take the frame's mean colour (only the mesh's edges could sample them).
     """
     opaque, _ = shape(sprite)
-    texels, emission = [], []
+    bins = depth_bins(unit_depth)
+    texels = np.zeros((len(sprite.frames), len(bins.depth), *opaque.shape, 3), dtype=np.uint8)
+    emission = np.zeros((len(sprite.frames), len(bins.depth)))
     for frame in range(len(sprite.frames)):
-        colour = _unlit(sprite, frame)
-        colour[~opaque] = colour[opaque].mean(axis=0)
-        white = max(float(colour.max()), palette.AMBIENT)
-        emission.append(white - palette.AMBIENT)
-        levels = [_box_mean(colour, opaque, box) for box in BOX_SIZES]
-        texels.append(np.round(np.stack(levels) / white * 255).astype(np.uint8))
-    return np.stack(texels), np.array(emission)
+        for k, (box, depth) in enumerate(zip(bins.box, bins.depth)):
+            # Doom's colours, over mjmaze's light on things there, which the renderers apply after.
+            colour = lit_picture(sprite, frame, depth) / 255.0 / float(palette.THING_LIGHT.gain(np.array(depth)))
+            colour[~opaque] = colour[opaque].mean(axis=0)
+            white = max(float(colour.max()), palette.AMBIENT)
+            emission[frame, k] = white - palette.AMBIENT
+            texels[frame, k] = np.round(_box_mean(colour, opaque, BOX_SIZES[box]) / white * 255)
+    return texels, emission
 
 
 def mean_colour(sprite: Sprite) -> tuple[float, float, float]:
-    """The mean (0-1) of ``sprite``'s drawn pixels over its animation (weighted by tics), before Doom's
-    light, over :data:`mjmaze.palette.AMBIENT`: the one colour a cylinder or a map shows it in (GL
-    draws a colour ``c`` as ``c x AMBIENT``)."""
+    """The mean (0-1) of ``sprite``'s pixels over its animation (weighted by tics) as Doom draws
+    them :data:`MEAN_COLOUR_DEPTH` ahead, before mjmaze's light on things there, over
+    :data:`mjmaze.palette.AMBIENT`: the one colour a cylinder or a map shows it in (GL draws a
+    colour ``c`` as ``c x AMBIENT``)."""
     opaque, _ = shape(sprite)
     tics = np.array([t for _, t, _ in sprite.frames], dtype=float)
-    mean = sum(t * _unlit(sprite, f)[opaque].mean(axis=0) for f, t in enumerate(tics)) / tics.sum()
+    gain = float(palette.THING_LIGHT.gain(np.array(MEAN_COLOUR_DEPTH)))
+    mean = sum(t * lit_picture(sprite, f, MEAN_COLOUR_DEPTH)[opaque].mean(axis=0) for f, t in enumerate(tics))
+    mean = mean / tics.sum() / 255.0 / gain
     return tuple(float(v) for v in np.minimum(mean / palette.AMBIENT, 1.0).round(3))
 
 
@@ -210,6 +283,9 @@ def mesh_quads(sprite: Sprite, z_centre: float, unit: float) -> tuple[np.ndarray
     """
     opaque, (left, top) = shape(sprite)
     height, width = opaque.shape
+    # Doom draws a picture's rows below its thing's origin (the armours' bottom 3) over the floor;
+    # mjmaze's floor would hide them, so the picture is lifted to stand on the floor, whole.
+    top = max(top, height)
     verts, coords = [], []
     for row in range(height):
         padded = np.concatenate([[False], opaque[row], [False]])

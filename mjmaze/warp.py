@@ -4,7 +4,7 @@
 gymnasium vector env whose observations, rewards, flags and ``info`` are torch
 tensors on ``device``; reached from the registry by one word::
 
-    envs = gymnasium.make_vec("mjmaze/Labyrinth-v8", num_envs=4096,
+    envs = gymnasium.make_vec("mjmaze/Labyrinth-v9", num_envs=4096,
                               vectorization_mode="vector_entry_point", backend="warp", size=9)
 
 It plays the same task as the CPU envs: the same configurations (splits,
@@ -69,9 +69,9 @@ def build_model(task: core.MazeRules) -> tuple[mujoco.MjModel, np.ndarray, np.nd
         first_of_layout.setdefault(int(mesh), config)
     quads = [walls.wall_mesh_quads(c.h_walls, c.v_walls, layout.cell_size) for c in first_of_layout.values()]
     xml = mjcf.build_xml(layout.grid_size, layout.cell_size, task.objects, task.visual_style, task.room,
-                         wall_layout_quads=quads)
+                         wall_layout_quads=quads, width=task.width)
     model = mujoco.MjModel.from_xml_string(xml)
-    mjcf.paint_textures(model, task.objects)
+    mjcf.paint_textures(model, task.objects, task.width)
     mjcf.set_ego_projection(model, task.width, task.height)
     for mesh, config in first_of_layout.items():
         mesh_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MESH, f"{walls.WALL_MESH}_{mesh}")

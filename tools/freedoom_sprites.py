@@ -2,12 +2,12 @@
 
     python tools/freedoom_sprites.py           # rebuild it from the paper's freedoom2.wad (fetched once)
     python tools/freedoom_sprites.py --check   # does the shipped file hold exactly those lumps?
-    python tools/freedoom_sprites.py --figure docs/sprites.png  # the pictures beside what mjmaze draws
+    python tools/freedoom_sprites.py --figure docs/sprites.png  # the pictures, and lit as Doom lights them
 
 The paper's agents saw Freedoom 0.10.1 (``tools/paper_agents_vizdoom.py``
 fetches its ``freedoom2.wad`` and checks it). mjmaze ships only the pictures
 of the eight things the released generators place as items, every frame of
-their animations (:data:`mjmaze.sprites.SPRITES`), and the palette, copied
+their animations (:data:`mjmaze.sprites.SPRITES`), the palette and the colormaps (Doom's light), copied
 byte for byte into a small PWAD, with Freedoom's licence beside it.
 """
 
@@ -25,8 +25,8 @@ TARGET = pathlib.Path(__file__).resolve().parent.parent / "mjmaze" / "freedoom" 
 
 
 def wanted_lumps(source: dict[str, bytes]) -> dict[str, bytes]:
-    """The palette, then every frame of every item sprite, from ``source``'s lumps."""
-    names = ["PLAYPAL"] + [f"{s.name}{frame}0" for s in sprites.SPRITES for frame in dict.fromkeys(f for f, _, _ in s.frames)]
+    """The palette and the colormaps, then every frame of every item sprite, from ``source``'s lumps."""
+    names = ["PLAYPAL", "COLORMAP"] + [f"{s.name}{frame}0" for s in sprites.SPRITES for frame in dict.fromkeys(f for f, _, _ in s.frames)]
     missing = [name for name in names if name not in source]
     if missing:
         raise SystemExit(f"error: the source wad lacks {missing}")
@@ -34,20 +34,19 @@ def wanted_lumps(source: dict[str, bytes]) -> dict[str, bytes]:
 
 
 def figure(path: pathlib.Path) -> None:
-    """Each sprite's frames as Freedoom draws them, then mjmaze's first frame at each averaging level, 4x."""
+    """Each sprite's frames as Freedoom draws them, then its first frame as Doom lights it 0.6, 1, 2 and
+    4 m ahead (``sprites.lit_picture``: its colormap there), 4x."""
     import numpy as np
     from PIL import Image
-
     rows = []
     for sprite in sprites.SPRITES:
         tiles = []
         for frame in dict.fromkeys(f for f, _, _ in sprite.frames):
             rgb, opaque, _ = sprites.picture(f"{sprite.name}{frame}0")
             tiles.append(np.where(opaque[..., None], rgb, 40))
-        texels, emission = sprites.textures(sprite)
         opaque, _ = sprites.shape(sprite)
-        for level in range(1, len(sprites.BOX_SIZES)):  # frame A averaged over 2, 3, 4, 6, 8, 12 pixels
-            tiles.append(np.where(opaque[..., None], texels[0, level], 40))
+        for depth in (0.6, 1.0, 2.0, 4.0):
+            tiles.append(np.where(opaque[..., None], sprites.lit_picture(sprite, 0, depth), 40))
         height = max(t.shape[0] for t in tiles)
         row = np.concatenate([np.pad(t, ((0, height - t.shape[0]), (0, 4), (0, 0)), constant_values=0) for t in tiles], 1)
         rows.append(row)

@@ -280,9 +280,10 @@ def task_class(rules_class: type) -> type:
 
 def make_environment(task: MazeTask, environment_kwargs: dict | None = None) -> control.Environment:
     """Compiles the task's arena and wraps it in a dm_control environment."""
-    xml = mjcf.build_xml(task.layout.grid_size, task.layout.cell_size, task.objects, task.visual_style, task.room)
+    xml = mjcf.build_xml(task.layout.grid_size, task.layout.cell_size, task.objects, task.visual_style, task.room,
+                         width=task.width)
     physics = MazePhysics.from_xml_string(xml)
-    mjcf.paint_textures(physics.model.ptr, task.objects)
+    mjcf.paint_textures(physics.model.ptr, task.objects, task.width)
     kwargs = dict(n_sub_steps=TICS_PER_STEP, legacy_step=False)
     kwargs.update(environment_kwargs or {})
     return control.Environment(physics, task, **kwargs)

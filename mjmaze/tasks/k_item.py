@@ -22,6 +22,11 @@ The collection order is item kind 1, then 2, ... by the released files' colour
 codes: green, red, blue, cyan, magenta, yellow, then two greys, which also
 differ in shape (:data:`KINDS`).
 Version History
+    * v8 (2026-11-27): items lit as Doom lights sprites: a sector-lit picture
+      through Doom's colormap at its depth (toward the palette's browns, not in
+      proportion), a fullbright one (the armours' blink) in its own colours at
+      any depth; a picture's rows below its origin drawn above the floor, whole;
+      the blue armour blinks 6 + 6 tics (docs/look.md, "Items").
     * v7 (2026-11-27): the released mazes' geometry and Doom's squares: inner
       walls end at their grid lines, the outer wall's face is the maze's
       edge; the agent block as squares aligned with the map and
@@ -149,7 +154,7 @@ class KItem(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="k_item",
     task=KItem,
-    gym_id="mjmaze/KItem-v7",
+    gym_id="mjmaze/KItem-v8",
     seed_code=3,
     difficulty="num_items",
     difficulties=NUM_ITEMS,

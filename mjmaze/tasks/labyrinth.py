@@ -16,6 +16,10 @@ Arguments
 Metric
     ``success``: whether the exit was reached (success rate = mean over episodes).
 Version History
+    * v9 (2026-11-27): the exit (the green armour's picture) lit as Doom lights
+      sprites: its sector-lit frame through Doom's colormap at its depth, its
+      fullbright blink in its own colours at any depth; its rows below its
+      origin drawn above the floor, whole (docs/look.md, "Items").
     * v8 (2026-11-27): the released mazes' geometry and Doom's squares: inner
       walls end at their grid lines, the outer wall's face is the maze's
       edge; the agent block as squares aligned with the map and
@@ -102,7 +106,7 @@ class Labyrinth(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="labyrinth",
     task=Labyrinth,
-    gym_id="mjmaze/Labyrinth-v8",
+    gym_id="mjmaze/Labyrinth-v9",
     seed_code=1,
     difficulty="size",
     difficulties=SIZES,

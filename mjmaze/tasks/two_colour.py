@@ -36,6 +36,11 @@ Arguments
 Metric
     ``duration``: tics survived (max 2100); also ``health`` and ``totem_green``.
 Version History
+    * v10 (2026-11-27): items lit as Doom lights sprites: a sector-lit picture
+      through Doom's colormap at its depth (toward the palette's browns, not in
+      proportion), a fullbright one (the armours' blink) in its own colours at
+      any depth; a picture's rows below its origin drawn above the floor, whole;
+      the blue armour blinks 6 + 6 tics (docs/look.md, "Items").
     * v9 (2026-11-27): the released mazes' geometry and Doom's squares: inner
       walls end at their grid lines, the outer wall's face is the maze's
       edge; the agent and the totem block as squares aligned with the map and
@@ -352,7 +357,7 @@ class TwoColour(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="two_colour",
     task=TwoColour,
-    gym_id="mjmaze/TwoColour-v9",
+    gym_id="mjmaze/TwoColour-v10",
     seed_code=4,
     difficulty="complexity",
     difficulties=COMPLEXITIES,
