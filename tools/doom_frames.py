@@ -7,6 +7,7 @@
     python tools/doom_frames.py --armour-parts  # the armours' coloured parts over their blink, 1-4 m ahead (Two-colour's items)
     python tools/doom_frames.py --projection    # ViZDoom's focal lengths across and down, beside mjmaze's
     python tools/doom_frames.py --light         # Doom's light over depth: both walls' sides, floor, ceiling
+    python tools/doom_frames.py --sprite-light --freedoom paper  # the items' colormap over depth (mjmaze.sprites)
     python tools/doom_frames.py --two-colour RELEASED_REPO/scenarios/basefiles/two_color_basefile.wad
                                             # the released Two-colour script played: health changes, tics survived
     python tools/doom_frames.py --calibrate --freedoom paper  # ... with the paper's Freedoom 0.10.1
@@ -50,7 +51,7 @@ GAME_WAD: str | None = None
 UNITS = 128  # Doom map units per metre (mjmaze's 1 m cell is the generator's 128 units)
 WALL_PAD = 8  # the generator's half thickness of a wall block
 SIZE = (112, 64)
-ANIMATION_TICS = 13  # Doom's armour sprites: ARM1 A 6 tics, B (bright) 7
+ANIMATION_TICS = 13  # Doom's armour sprites: ARM1 A 6 tics, B (bright) 7 (ARM2: 6 and 6)
 ANIMATION_A_TICS = 6
 # mjmaze's sprites animate by the level's tic, 4 a step from tic 10: 13 steps show every tic of the
 # armours' 13-tic cycle once (and most of the keycards' and soulsphere's).
@@ -170,7 +171,7 @@ def doom_tics(text: str, weapon: bool = True, resize: bool = True) -> tuple[np.n
         write_wad(wad, text)
         game = released_game(wad, weapon)
         game.advance_action(RAISE_TICS)
-        # Armour blinks (a plain frame 6 tics, a bright one 7): a whole cycle.
+        # Armours blink (a plain frame 6 tics, a bright one 7; the blue armour 6 and 6): a whole cycle.
         screens, masks = [], []
         for _ in range(ANIMATION_TICS):
             state = game.get_state()
@@ -423,6 +424,49 @@ def light() -> None:
     env.task.close()
 
 
+def sprite_light() -> None:
+    """Prints the colormap Doom draws each item's sector-lit picture with, over depth, beside mjmaze's.
+
+    ViZDoom's frames at the released 320x180, the item ``d`` metres ahead in
+    the empty stone arena, every tic of its animation: the dimmest frame's
+    pixels (labels buffer) are the sector-lit picture, the brightest the
+    fullbright one (armours, keycards). The fitted colormap is the one whose
+    colours of the picture's palette indices (``sprites.colormaps``) come
+    nearest the drawn mean; mjmaze draws ``sprites.colormap_of_depth(d)``.
+    Use ``--freedoom paper``: the pictures are Freedoom 0.10.1's.
+    """
+    env = empty_arena("stone", pistol=False)
+    config = env.task.config
+    env.task.close()
+    palette_rgb = sprites.palette_colours().astype(np.float64)
+    kinds = ((GREEN_ARMOUR, sprites.GREEN_ARMOUR), (BLUE_ARMOUR, sprites.BLUE_ARMOUR), (2012, sprites.MEDIKIT),
+             (13, sprites.RED_KEYCARD))
+    print("d m ahead: ViZDoom's sector-lit picture (mean RGB), the colormap nearest it | mjmaze's colormap, its "
+          "picture's mean; ViZDoom's fullbright picture | its palette colours")
+    for doom_type, sprite in kinds:
+        indices, opaque, _ = sprites.picture_indices(f"{sprite.name}{sprite.frames[0][0]}0")
+        by_colormap = np.array([palette_rgb[sprites.colormaps()[c][indices[opaque]]].mean(axis=0)
+                                for c in range(sprites.NUM_COLORMAPS)])
+        rows = []
+        for d in (0.5, 0.6, 0.8, 1.0, 1.5, 2.0, 2.5, 3.0, 4.0):
+            screens, drawn = doom_tics(textmap(config, (0.0, 0.0, 0), [Thing(d * UNITS, 0.0, doom_type)], STONE),
+                                       weapon=False, resize=False)
+            means = np.array([screen[mask].astype(np.float64).mean(axis=0) for screen, mask in zip(screens, drawn)])
+            dim, bright = means[means.sum(axis=1).argmin()], means[means.sum(axis=1).argmax()]
+            fitted = int(np.abs(by_colormap - dim).sum(axis=1).argmin())
+            ours = int(sprites.colormap_of_depth(np.array(d)))
+            row = (f"{d}: {np.round(dim).astype(int).tolist()} {fitted:2d} | {ours:2d} "
+                   f"{np.round(by_colormap[ours]).astype(int).tolist()}")
+            if any(bright_frame for _, _, bright_frame in sprite.frames):
+                row += f"; {np.round(bright).astype(int).tolist()}"
+            rows.append(row)
+        lit_palette = [f for f in sprite.frames if f[2]]
+        if lit_palette:
+            rgb, mask, _ = sprites.picture(f"{sprite.name}{lit_palette[0][0]}0")
+            rows.append(f"fullbright palette colours {np.round(rgb[mask].mean(axis=0)).astype(int).tolist()}")
+        print(f"  {sprite.name}:\n    " + "\n    ".join(rows))
+
+
 def armour_parts() -> None:
     """Prints the colour of the armours' coloured parts, 1 to 4 m ahead in the empty slime arena.
 
@@ -602,6 +646,8 @@ def main() -> None:
     parser.add_argument("--armour-parts", action="store_true", help="print the armours' coloured parts over their blink, 1-4 m ahead")
     parser.add_argument("--projection", action="store_true", help="print ViZDoom's focal lengths beside mjmaze's")
     parser.add_argument("--light", action="store_true", help="print Doom's light over depth beside mjmaze's")
+    parser.add_argument("--sprite-light", action="store_true",
+                        help="print the colormap Doom draws the items' pictures with over depth, beside mjmaze's")
     parser.add_argument("--episodes", type=int, default=32, help="episodes for --two-colour")
     parser.add_argument("--freedoom", default="vizdoom", metavar="vizdoom|paper|PATH",
                         help="the game data: vizdoom (default: ViZDoom's own), paper (Freedoom 0.10.1) or a wad")
@@ -612,6 +658,8 @@ def main() -> None:
     GAME_WAD = freedoom_path(args.freedoom)
     if args.light:
         light()
+    elif args.sprite_light:
+        sprite_light()
     elif args.projection:
         projection()
     elif args.armour_parts:

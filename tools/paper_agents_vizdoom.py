@@ -3,6 +3,8 @@
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT [--only labyrinth_9 two_colour_1] [--out FILE]
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --agreement labyrinth_7   # the same action at the same pose? how far apart are the frames?
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --agreement two_colour_1  # ... with ViZDoom's items placed
+    python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --along k_item_6        # ViZDoom's frames along mjmaze's path: memory or frame?
+    python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --swap k_item_6 --sight vizdoom  # mjmaze's motion, ViZDoom's frames
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --picks two_colour_5      # right and wrong picks, both engines
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --motion labyrinth_13     # each step from ViZDoom's state: where it lands
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --shift 1 --out F         # frames moved 1 px: the probe's scale
@@ -101,11 +103,17 @@ def freedoom_path(choice: str) -> str | None:
     return choice
 
 
-def _game(cfg: pathlib.Path, seed: int = 0, objects: bool = False, wad: str | None = None):
+def _game(cfg: pathlib.Path, seed: int = 0, objects: bool = False, wad: str | None = None,
+          teleport: bool = False, labels: bool = False):
+    """The released maze's game; ``teleport``: with cheats on (the ``warp`` command) and a fifth button that
+    turns by a given angle, to put the player at any pose; ``labels``: with the buffer of where things are drawn."""
     import vizdoom as vzd
 
     game = vzd.DoomGame()
     game.load_config(str(cfg))
+    if teleport:
+        game.add_available_button(vzd.Button.TURN_LEFT_RIGHT_DELTA)
+        game.add_game_args("+sv_cheats 1")
     if wad is not None:
         game.set_doom_game_path(wad)  # the released .cfg names none: ViZDoom's own freedoom2.wad
     game.set_seed(seed)  # Doom's random spawn heading and item draws: the same episodes on every run
@@ -113,6 +121,7 @@ def _game(cfg: pathlib.Path, seed: int = 0, objects: bool = False, wad: str | No
     game.set_sound_enabled(False)
     game.set_window_visible(False)
     game.set_objects_info_enabled(objects)  # every thing's name and position, each state
+    game.set_labels_buffer_enabled(labels)
     game.init()
     return game
 
@@ -344,6 +353,162 @@ def motion(name: str, checkout: str, mazes: int = 8, wad: str | None = None) -> 
     return np.array(rows)
 
 
+def _teleport(game, x: float, y: float, yaw: float, centre: np.ndarray):
+    """Puts ViZDoom's player at mjmaze's pose (metres, radians) of a maze centred on ``centre``; its state.
+
+    The game must be made with ``teleport=True``; each call takes two tics
+    (a long walk ends ViZDoom's episode: a new one is started, the things
+    back in place, as the teleports never pick them up).
+    """
+    import math
+
+    import vizdoom as vzd
+
+    if game.is_episode_finished() or game.get_episode_time() > 1800:
+        game.new_episode()
+    game.send_game_command(f"warp {x / mjcf.MAP_UNIT + centre[0]:.3f} {y / mjcf.MAP_UNIT + centre[1]:.3f}")
+    game.make_action([0] * 5, 1)  # the warp takes effect on the next tic
+    angle = game.get_game_variable(vzd.GameVariable.ANGLE)
+    game.make_action([0, 0, 0, 0, angle - math.degrees(yaw) % 360], 1)  # the delta turns clockwise
+    return game.get_state()
+
+
+def along(name: str, checkout: str, mazes: int = 8, wad: str | None = None) -> dict[str, float]:
+    """The agent plays mjmaze; at each of its poses ViZDoom's frame is drawn too, and fed to a second memory.
+
+    The reverse of :func:`agreement`, and for the scenarios whose things the
+    released maps place (Labyrinth, Find-and-return, K-item): ViZDoom's player
+    is teleported to each pose of mjmaze's greedy episode (the ``warp``
+    command, a turn by the angle left), up to mjmaze's first reward or end, so
+    its things are all still on the floor in both engines. The same network
+    runs twice along the path, once on mjmaze's frames and once on ViZDoom's,
+    each with its own memory. Where the two choose differently, the frames
+    and memories are crossed: does mjmaze's frame with ViZDoom's memory choose
+    ViZDoom's action (the memory decides), or ViZDoom's frame with mjmaze's
+    memory (the frame decides)? Returns those shares, the share of steps
+    alike, and the memories' mean relative distance.
+    """
+    import mjmaze
+
+    info = paper_agents.get(name)
+    if info.scenario == "two_colour":
+        raise ValueError("--along takes a Labyrinth, Find-and-return or K-item agent: Two-colour's items are "
+                         "drawn by its script, so ViZDoom's would not be mjmaze's")
+    torch.set_num_threads(1)  # one frame at a time: more threads only contend
+    _, agent, _ = paper_agents.load(name, paper_dir=checkout)
+    folder = pathlib.Path(checkout) / paper_agents.MAZES / info.maze_folder / "test"
+    env = mjmaze.load(info.scenario, task_kwargs={**info.task_kwargs, "layouts": str(folder), "head_bob": False,
+                                                  "random": 1})
+    def choose(frame: np.ndarray, hidden: torch.Tensor, start: bool) -> tuple[int, torch.Tensor]:
+        with torch.no_grad():
+            logits, _, hidden = agent.step(agent.features(torch.from_numpy(frame[None])), hidden,
+                                           torch.tensor([start]))
+        return int(logits.argmax()), hidden
+
+    same, memory, frame_decides, gap = [], [], [], []
+    for index in range(mazes):
+        maze = json.loads((folder / f"custom_scenario{index:03d}.json").read_text())
+        centre = np.mean(np.array(maze["exterior"], dtype=float), axis=0)
+        game = _game(folder / f"custom_scenario{index:03d}.cfg", seed=index, wad=wad, teleport=True)
+        _reset_to(env, index)
+        ours_hidden, doom_hidden = agent.initial_state(1), agent.initial_state(1)
+        time_step, start = None, True
+        while time_step is None or not (time_step.last() or time_step.reward > 0):
+            _teleport(game, *env.physics.agent_pose(), centre)
+            doom = _frame(game)
+            ours = np.ascontiguousarray(env.task.get_observation(env.physics)["pixels"])
+            ours_action, next_ours = choose(ours, ours_hidden, start)
+            doom_action, next_doom = choose(doom, doom_hidden, start)
+            same.append(ours_action == doom_action)
+            if not same[-1] and not start:
+                memory.append(choose(ours, doom_hidden, False)[0] == doom_action)
+                frame_decides.append(choose(doom, ours_hidden, False)[0] == doom_action)
+            gap.append(float(torch.norm(next_ours - next_doom) / torch.norm(next_doom)))
+            ours_hidden, doom_hidden, start = next_ours, next_doom, False
+            time_step = env.step(ours_action)
+        game.close()
+    env.task.close()
+    return {"same": float(np.mean(same)), "memory": float(np.mean(memory)),
+            "frame": float(np.mean(frame_decides)), "memory_gap": float(np.mean(gap)), "steps": len(same)}
+
+
+SIGHTS = ("mjmaze", "vizdoom", "vizdoom-scenery", "mjmaze-scenery")
+
+
+def swap(name: str, checkout: str, sight: str, mazes: int = 64, plays: int = 4,
+         wad: str | None = None) -> dict[str, int]:
+    """The agent plays mjmaze's test mazes to its first reward, seeing ``sight``; how its episodes end.
+
+    mjmaze moves the agent and keeps the rules; what it sees at each pose is
+    mjmaze's frame, ViZDoom's (its player teleported there, :func:`_teleport`),
+    ViZDoom's with mjmaze's things pasted in (``vizdoom-scenery``: walls,
+    floor and ceiling ViZDoom's) or mjmaze's with ViZDoom's things
+    (``mjmaze-scenery``); a thing's pixels are where either engine draws one
+    (ViZDoom's labels buffer, mjmaze's frame against one without things),
+    blended by ViZDoom's coverage. Up to the first reward no thing has been
+    taken, so both engines hold the same. Returns the episodes that ended on
+    a reward (``right``), on a penalty (``wrong``: K-item's wrong item) or
+    without either (``none``). For Labyrinth, Find-and-return and K-item.
+    """
+    import cv2
+
+    import mjmaze
+
+    if sight not in SIGHTS:
+        raise ValueError(f"--sight must be one of {SIGHTS}, got {sight!r}")
+    info = paper_agents.get(name)
+    if info.scenario == "two_colour":
+        raise ValueError("--swap takes a Labyrinth, Find-and-return or K-item agent: Two-colour's items are "
+                         "drawn by its script, so ViZDoom's would not be mjmaze's")
+    torch.set_num_threads(1)  # one frame at a time: more threads only contend
+    _, agent, _ = paper_agents.load(name, paper_dir=checkout)
+    folder = pathlib.Path(checkout) / paper_agents.MAZES / info.maze_folder / "test"
+    env = mjmaze.load(info.scenario, task_kwargs={**info.task_kwargs, "layouts": str(folder), "head_bob": False,
+                                                  "random": 1})
+    task, physics = env.task, env.physics
+    ends = {"right": 0, "wrong": 0, "none": 0}
+    for index in range(mazes):
+        maze = json.loads((folder / f"custom_scenario{index:03d}.json").read_text())
+        centre = np.mean(np.array(maze["exterior"], dtype=float), axis=0)
+        game = None
+        if sight != "mjmaze":
+            game = _game(folder / f"custom_scenario{index:03d}.cfg", seed=index, wad=wad, teleport=True, labels=True)
+        for _ in range(plays):
+            _reset_to(env, index)
+            hidden, start, time_step = agent.initial_state(1), True, None
+            while time_step is None or not (time_step.last() or time_step.reward > 0):
+                frame = np.ascontiguousarray(task.get_observation(physics)["pixels"])
+                if game is not None:
+                    state = _teleport(game, *physics.agent_pose(), centre)
+                    doom = cv2.resize(state.screen_buffer.transpose(1, 2, 0), SIZE, interpolation=cv2.INTER_AREA)
+                    if sight == "vizdoom":
+                        frame = doom
+                    else:
+                        things = [label.value for label in state.labels if label.object_name != "DoomPlayer"]
+                        covered = cv2.resize(np.isin(state.labels_buffer, things).astype(np.float32), SIZE,
+                                             interpolation=cv2.INTER_AREA)
+                        shown = task.state["object_shown"][task.row].copy()
+                        task.state["object_shown"][task.row] = False
+                        task._sync_objects(physics)
+                        bare = task.get_observation(physics)["pixels"]
+                        task.state["object_shown"][task.row] = shown
+                        task._sync_objects(physics)
+                        ours_drawn = (frame != bare).any(axis=-1)
+                        weight = np.maximum(covered, ours_drawn)[..., None]
+                        things_from, scenery_from = (frame, doom) if sight == "vizdoom-scenery" else (doom, frame)
+                        frame = np.rint(weight * things_from + (1 - weight) * scenery_from).astype(np.uint8)
+                with torch.no_grad():
+                    logits, _, hidden = agent.step(agent.features(torch.from_numpy(frame[None])), hidden,
+                                                   torch.tensor([start]))
+                start = False
+                time_step = env.step(int(logits.argmax()))
+            ends["right" if time_step.reward > 0 else "wrong" if time_step.reward < -0.1 else "none"] += 1
+        if game is not None:
+            game.close()
+    task.close()
+    return ends
+
+
 def frame_gaps(doom: np.ndarray, ours: np.ndarray, block: int = 8) -> tuple[float, float, float]:
     """Mean absolute grey difference of two ``(H, W, 3)`` frames: per pixel, in ``block`` x ``block`` means, per column."""
     a, b = (frame.astype(np.float64).mean(axis=2) for frame in (doom, ours))
@@ -496,33 +661,63 @@ def main() -> None:
     parser.add_argument("--motion", metavar="SETTING", default=None,
                         help="instead: how far mjmaze's step lands from ViZDoom's, from ViZDoom's state at each "
                              "step of the agent's path")
-    parser.add_argument("--mazes", type=int, default=8, help="test mazes for --agreement and --motion (default 8)")
+    parser.add_argument("--along", metavar="SETTING", default=None,
+                        help="instead: the agent plays mjmaze and sees ViZDoom's frame at each pose too (Labyrinth, "
+                             "Find-and-return, K-item): how often it acts alike, and whether its memory or the frame "
+                             "decides where it does not")
+    parser.add_argument("--swap", metavar="SETTING", default=None,
+                        help="instead: the agent plays mjmaze to its first reward seeing --sight (Labyrinth, "
+                             "Find-and-return, K-item): how its episodes end")
+    parser.add_argument("--sight", default="mjmaze", choices=SIGHTS,
+                        help="for --swap: mjmaze's frames, ViZDoom's at the same poses, or one engine's scenery "
+                             "with the other's things")
+    parser.add_argument("--mazes", type=int, default=None,
+                        help="test mazes for --agreement, --along and --motion (default 8) and --swap (default 64)")
     parser.add_argument("--freedoom", default="paper", metavar="paper|vizdoom|PATH",
                         help="the game data: paper (default: Freedoom 0.10.1, as the paper's ViZDoom 1.1.4 had it; "
                              "fetched once), vizdoom (the installed ViZDoom's own), or a freedoom2.wad")
     args = parser.parse_args()
+    if args.mazes is not None and args.mazes < 1:
+        raise SystemExit(f"error: --mazes must be 1 or more, got {args.mazes}")
+    mazes = args.mazes or (64 if args.swap else 8)
     wad = freedoom_path(args.freedoom)
     if args.agreement:
         scenario = paper_agents.get(args.agreement).scenario
         if scenario not in ("labyrinth", "two_colour"):
             raise SystemExit("error: --agreement takes a Labyrinth or Two-colour agent (labyrinth_7 .. two_colour_7)")
-        if args.mazes < 1:
-            raise SystemExit(f"error: --mazes must be 1 or more, got {args.mazes}")
-        share, shifted, gap = agreement(args.agreement, str(args.checkout), mazes=args.mazes, wad=wad)
+        share, shifted, gap = agreement(args.agreement, str(args.checkout), mazes=mazes, wad=wad)
         print(f"{args.agreement}: the same action at {share:.1%} of the poses of its ViZDoom episodes (first "
-              f"{args.mazes} test mazes); on ViZDoom's own frames moved 1 pixel sideways: {shifted:.1%}")
+              f"{mazes} test mazes); on ViZDoom's own frames moved 1 pixel sideways: {shifted:.1%}")
         print(f"  the frames' mean grey difference at those poses: {gap['pixel']:.2f} per pixel, {gap['block']:.2f} "
               f"in 8x8 blocks, {gap['column']:.2f} per column")
         if scenario == "two_colour":
-            hidden = agreement(args.agreement, str(args.checkout), mazes=args.mazes, hide_items=True, wad=wad)[0]
+            hidden = agreement(args.agreement, str(args.checkout), mazes=mazes, hide_items=True, wad=wad)[0]
             print(f"  with mjmaze's items hidden: {hidden:.1%}")
         return
+    if args.swap:
+        try:
+            ends = swap(args.swap, str(args.checkout), args.sight, mazes=mazes, plays=args.plays,
+                        wad=wad)
+        except ValueError as error:
+            raise SystemExit(f"error: {error}") from None
+        total = sum(ends.values())
+        print(f"{args.swap}, seeing {args.sight}: {total} episodes to the first reward on the first "
+              f"{mazes} test mazes: " + ", ".join(f"{k} {v} ({v / total:.1%})" for k, v in ends.items()))
+        return
+    if args.along:
+        try:
+            result = along(args.along, str(args.checkout), mazes=mazes, wad=wad)
+        except ValueError as error:
+            raise SystemExit(f"error: {error}") from None
+        print(f"{args.along}, {result['steps']} steps of mjmaze's episodes on the first {mazes} test mazes (to the "
+              f"first reward): the same action on ViZDoom's frames at {result['same']:.1%}; where not, mjmaze's frame "
+              f"with ViZDoom's memory acts as ViZDoom at {result['memory']:.1%}, ViZDoom's frame with mjmaze's memory "
+              f"at {result['frame']:.1%}; the memories {result['memory_gap']:.2f} apart (relative)")
+        return
     if args.motion:
-        if args.mazes < 1:
-            raise SystemExit(f"error: --mazes must be 1 or more, got {args.mazes}")
-        rows = motion(args.motion, str(args.checkout), mazes=args.mazes, wad=wad)
+        rows = motion(args.motion, str(args.checkout), mazes=mazes, wad=wad)
         miss = rows[:, 0]
-        print(f"{args.motion}, {len(rows)} steps of the first {args.mazes} test mazes: mjmaze's step lands "
+        print(f"{args.motion}, {len(rows)} steps of the first {mazes} test mazes: mjmaze's step lands "
               f"{miss.mean():.2f} map units from ViZDoom's on average (median {np.median(miss):.2f}, 99th "
               f"percentile {np.percentile(miss, 99):.1f}); over 4 units at {(miss > 4).mean():.1%} of steps, over 16 "
               f"at {(miss > 16).mean():.1%}; mean move ViZDoom {rows[:, 1].mean():.2f}, mjmaze {rows[:, 2].mean():.2f}")
