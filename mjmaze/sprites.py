@@ -34,7 +34,7 @@ BOX_SIZES = (1, 2, 3, 4, 6, 8, 12)
 #: it: colormap ``floor(SPRITE_SHADE - SPRITE_VISIBILITY / depth)`` of ``NUM_COLORMAPS``, depth
 #: in metres. ``SPRITE_SHADE`` is ZDoom's LIGHT2SHADE of the released sectors' light level, 160;
 #: ``SPRITE_VISIBILITY`` fits ViZDoom's frames (the armours', medikit's and keycards' sector-lit
-#: pictures 0.5-5 m ahead, ``python tools/doom_frames.py --sprite-light``; docs/look.md). Its
+#: pictures 0.5-4 m ahead, ``python tools/doom_frames.py --sprite-light``; docs/look.md). Its
 #: colormaps darken a colour toward the palette's browns, not in proportion: Freedoom's red armour
 #: 4 m ahead is (41, 32, 26) in ViZDoom, where scaling its colours would give (50, 27, 28).
 NUM_COLORMAPS = 32
@@ -185,6 +185,7 @@ def depth_bins(unit_depth: float) -> DepthBins:
     # The colormap steps where SHADE - VISIBILITY / depth crosses a whole number.
     light_edges = SPRITE_VISIBILITY / (SPRITE_SHADE - np.arange(1, SPRITE_SHADE))
     edges = np.unique(np.concatenate([box_edges, light_edges]))
+    # Each bin is drawn for its geometric middle; the open-ended first and last for a depth inside them.
     middles = np.concatenate([[edges[0] * 0.75], np.sqrt(edges[:-1] * edges[1:]), [edges[-1] * 1.5]])
     box = np.searchsorted(box_edges, middles)
     return DepthBins(edges, tuple(int(b) for b in box), tuple(float(d) for d in middles))
