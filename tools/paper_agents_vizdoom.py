@@ -247,8 +247,7 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
     task = env.task
     same, same_shifted, gaps = [], [], []
     for index in range(mazes):
-        maze = json.loads((folder / f"custom_scenario{index:03d}.json").read_text())
-        centre = np.mean(np.array(maze["exterior"], dtype=float), axis=0)  # mjmaze centres the maze on (0, 0)
+        centre = _maze_centre(folder, index)
         game = _game(folder / f"custom_scenario{index:03d}.cfg", seed=index, objects=two_colour, wad=wad)
         path = []
         hidden, start = agent.initial_state(1), torch.ones(1, dtype=torch.bool)
@@ -320,8 +319,7 @@ def motion(name: str, checkout: str, mazes: int = 8, wad: str | None = None) -> 
     per_tic = mjcf.MAP_UNIT / physics.model.opt.timestep  # map units a tic -> m/s
     rows = []
     for index in range(mazes):
-        maze = json.loads((folder / f"custom_scenario{index:03d}.json").read_text())
-        centre = np.mean(np.array(maze["exterior"], dtype=float), axis=0)
+        centre = _maze_centre(folder, index)
         game = _game(folder / f"custom_scenario{index:03d}.cfg", seed=index, wad=wad)
         variables = [getattr(vzd.GameVariable, v) for v in (*_POSE, "VELOCITY_X", "VELOCITY_Y")]
         hidden, start = agent.initial_state(1), torch.ones(1, dtype=torch.bool)
@@ -373,6 +371,32 @@ def _teleport(game, x: float, y: float, yaw: float, centre: np.ndarray):
     return game.get_state()
 
 
+def _played_in_mjmaze(name: str, checkout: str, probe: str):
+    """``(agent, test folder, env)`` for a probe where agent ``name`` plays mjmaze's released test mazes
+    and ViZDoom follows it (head-bob off: ViZDoom's teleported player stands still).
+
+    Two-colour's items are drawn by its script, so ViZDoom's would not be mjmaze's: refused.
+    """
+    import mjmaze
+
+    info = paper_agents.get(name)
+    if info.scenario == "two_colour":
+        raise ValueError(f"{probe} takes a Labyrinth, Find-and-return or K-item agent: Two-colour's items are "
+                         "drawn by its script, so ViZDoom's would not be mjmaze's")
+    torch.set_num_threads(1)  # one frame at a time: more threads only contend
+    _, agent, _ = paper_agents.load(name, paper_dir=checkout)
+    folder = pathlib.Path(checkout) / paper_agents.MAZES / info.maze_folder / "test"
+    env = mjmaze.load(info.scenario, task_kwargs={**info.task_kwargs, "layouts": str(folder), "head_bob": False,
+                                                  "random": 1})
+    return agent, folder, env
+
+
+def _maze_centre(folder: pathlib.Path, index: int) -> np.ndarray:
+    """Released maze ``index``'s centre in map units (mjmaze centres the maze on (0, 0))."""
+    maze = json.loads((folder / f"custom_scenario{index:03d}.json").read_text())
+    return np.mean(np.array(maze["exterior"], dtype=float), axis=0)
+
+
 def along(name: str, checkout: str, mazes: int = 8, wad: str | None = None) -> dict[str, float]:
     """The agent plays mjmaze; at each of its poses ViZDoom's frame is drawn too, and fed to a second memory.
 
@@ -388,17 +412,8 @@ def along(name: str, checkout: str, mazes: int = 8, wad: str | None = None) -> d
     memory (the frame decides)? Returns those shares, the share of steps
     alike, and the memories' mean relative distance.
     """
-    import mjmaze
+    agent, folder, env = _played_in_mjmaze(name, checkout, "--along")
 
-    info = paper_agents.get(name)
-    if info.scenario == "two_colour":
-        raise ValueError("--along takes a Labyrinth, Find-and-return or K-item agent: Two-colour's items are "
-                         "drawn by its script, so ViZDoom's would not be mjmaze's")
-    torch.set_num_threads(1)  # one frame at a time: more threads only contend
-    _, agent, _ = paper_agents.load(name, paper_dir=checkout)
-    folder = pathlib.Path(checkout) / paper_agents.MAZES / info.maze_folder / "test"
-    env = mjmaze.load(info.scenario, task_kwargs={**info.task_kwargs, "layouts": str(folder), "head_bob": False,
-                                                  "random": 1})
     def choose(frame: np.ndarray, hidden: torch.Tensor, start: bool) -> tuple[int, torch.Tensor]:
         with torch.no_grad():
             logits, _, hidden = agent.step(agent.features(torch.from_numpy(frame[None])), hidden,
@@ -407,8 +422,7 @@ def along(name: str, checkout: str, mazes: int = 8, wad: str | None = None) -> d
 
     same, memory, frame_decides, gap = [], [], [], []
     for index in range(mazes):
-        maze = json.loads((folder / f"custom_scenario{index:03d}.json").read_text())
-        centre = np.mean(np.array(maze["exterior"], dtype=float), axis=0)
+        centre = _maze_centre(folder, index)
         game = _game(folder / f"custom_scenario{index:03d}.cfg", seed=index, wad=wad, teleport=True)
         _reset_to(env, index)
         ours_hidden, doom_hidden = agent.initial_state(1), agent.initial_state(1)
@@ -452,24 +466,13 @@ def swap(name: str, checkout: str, sight: str, mazes: int = 64, plays: int = 4,
     """
     import cv2
 
-    import mjmaze
-
     if sight not in SIGHTS:
         raise ValueError(f"--sight must be one of {SIGHTS}, got {sight!r}")
-    info = paper_agents.get(name)
-    if info.scenario == "two_colour":
-        raise ValueError("--swap takes a Labyrinth, Find-and-return or K-item agent: Two-colour's items are "
-                         "drawn by its script, so ViZDoom's would not be mjmaze's")
-    torch.set_num_threads(1)  # one frame at a time: more threads only contend
-    _, agent, _ = paper_agents.load(name, paper_dir=checkout)
-    folder = pathlib.Path(checkout) / paper_agents.MAZES / info.maze_folder / "test"
-    env = mjmaze.load(info.scenario, task_kwargs={**info.task_kwargs, "layouts": str(folder), "head_bob": False,
-                                                  "random": 1})
+    agent, folder, env = _played_in_mjmaze(name, checkout, "--swap")
     task, physics = env.task, env.physics
     ends = {"right": 0, "wrong": 0, "none": 0}
     for index in range(mazes):
-        maze = json.loads((folder / f"custom_scenario{index:03d}.json").read_text())
-        centre = np.mean(np.array(maze["exterior"], dtype=float), axis=0)
+        centre = _maze_centre(folder, index)
         game = None
         if sight != "mjmaze":
             game = _game(folder / f"custom_scenario{index:03d}.cfg", seed=index, wad=wad, teleport=True, labels=True)
@@ -543,8 +546,7 @@ def picks(name: str, checkout: str, mazes: int = 32, wad: str | None = None) -> 
     folder = pathlib.Path(checkout) / paper_agents.MAZES / info.maze_folder / "test"
     episodes = {"vizdoom": [], "mjmaze": []}
     for index in range(mazes):
-        maze = json.loads((folder / f"custom_scenario{index:03d}.json").read_text())
-        centre = np.mean(np.array(maze["exterior"], dtype=float), axis=0)
+        centre = _maze_centre(folder, index)
         game = _game(folder / f"custom_scenario{index:03d}.cfg", seed=_maze_seed(1, index), objects=True,
                      wad=wad)
         game.add_available_game_variable(vzd.GameVariable.USER1)  # the script's global 1, shaping_reward (fixed point)
