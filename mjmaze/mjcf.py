@@ -9,6 +9,7 @@ for one env or, with ``wall_layout_quads``, for MuJoCo Warp's batch of worlds;
 from __future__ import annotations
 
 import dataclasses
+import functools
 import importlib.resources
 import math
 import pathlib
@@ -147,7 +148,7 @@ def build_xml(
     ET.SubElement(asset, "material", name="ceiling", rgba=" ".join(f"{v / glow:.4f}" for v in room.ceiling) + " 1",
                   emission=f"{glow - palette.AMBIENT}", specular="0", shininess="0", reflectance="0")
     if visual_style == "textured":
-        _add_textures(root)
+        _add_textures(root, room)
     segments = walls.wall_segments(grid_size, cell_size)
 
     if batch:
@@ -248,7 +249,7 @@ def set_ego_projection(model: mujoco.MjModel, width: int, height: int) -> None:
     model.cam_intrinsic[camera] = (DOOM_FOCAL_ACROSS * width, DOOM_FOCAL_DOWN * height, 0.0, 0.0)
 
 
-def _add_textures(root: ET.Element) -> None:
+def _add_textures(root: ET.Element, room: palette.Room) -> None:
     """Textures on the wall and floor materials, and GL's even light (Doom's comes after)."""
     asset = root.find("asset")
     for name in ("wall", "floor"):
@@ -258,18 +259,47 @@ def _add_textures(root: ET.Element) -> None:
             width=str(palette.TEXTURE_TEXELS), height=str(palette.TEXTURE_TEXELS), rgb1="1 1 1",
         )
         # GL multiplies the grey texels by the material's colour: brighten it
-        # so a surface keeps the flat style's mean colour (and maps, drawn
-        # without textures, keep its hue).
+        # by the texels' gain so a surface keeps the room's mean colour (and
+        # maps, drawn without textures, keep its hue).
         material = asset.find(f"material[@name='{name}']")
         material.set("texture", name)
-        rgba = np.array(material.get("rgba").split(), dtype=float)
-        rgba[:3] = np.minimum(rgba[:3] * palette.TEXTURE_GAIN[name], 1.0)
-        material.set("rgba", " ".join(f"{v:.3f}" for v in rgba))
+        colour = getattr(room, name)
+        _, gain = surface_texels(getattr(room, f"{name}_texture"), colour)
+        material.set("rgba", " ".join(f"{min(v * gain, 1.0):.4f}" for v in colour) + " 1")
     # The floor repeats its texture once per metre; the wall mesh carries
     # texture coordinates in metres.
     asset.find("material[@name='floor']").set("texuniform", "true")
     asset.find("material[@name='floor']").set("texrepeat", "1 1")
     _ambient_light(root)
+
+
+@functools.lru_cache(maxsize=None)
+def surface_texels(texture: str, colour: tuple[float, float, float]) -> tuple[np.ndarray, float]:
+    """Freedoom's ``texture`` (:func:`mjmaze.sprites.surface`) as mjmaze draws it on a surface of mean ``colour``:
+    ``(texels (TEXTURE_TEXELS, TEXTURE_TEXELS, 3) uint8 for a metre, gain)``.
+
+    The texels are the picture's grey pattern (its colours' mean, tiled to a
+    metre, 128 map units, and averaged over 2 x 2 units) over its mean,
+    divided by ``gain``: GL multiplies them by the material's colour, the
+    room's ``colour`` times ``gain``, so the surface's mean stays the room's
+    calibrated colour (:class:`mjmaze.palette.Room`; every calibration of the
+    mean colours and of Doom's light holds). ``gain`` is the pattern's
+    brightest texel over its mean (none saturates), at most what keeps the
+    material's colour under 1 (then the brightest few saturate).
+    """
+    grey = sprites.surface(texture).astype(np.float64).mean(axis=2)
+    if texture in sprites.FLATS:
+        # A flat's rows run along Doom's y; MuJoCo's uniform plane texture runs its rows along x
+        # (of the 8 ways to lay FLAT1_1, this one's frames are nearest ViZDoom's at 4 poses).
+        grey = grey.T
+    metre = round(1 / MAP_UNIT)
+    grey = np.tile(grey, (-(-metre // grey.shape[0]), -(-metre // grey.shape[1])))[:metre, :metre]
+    fold = metre // palette.TEXTURE_TEXELS
+    grey = grey.reshape(palette.TEXTURE_TEXELS, fold, palette.TEXTURE_TEXELS, fold).mean(axis=(1, 3))
+    pattern = grey / grey.mean()
+    gain = min(float(pattern.max()), 1 / max(colour))
+    texels = np.clip(np.round(pattern / gain * 255), 0, 255).astype(np.uint8)
+    return np.repeat(texels[..., None], 3, axis=2), gain
 
 
 def _ambient_light(root: ET.Element) -> None:
@@ -286,12 +316,12 @@ def _ambient_light(root: ET.Element) -> None:
     headlight.set("diffuse", "0 0 0")
 
 
-def paint_textures(model: mujoco.MjModel, objects: Sequence[ObjectGeom], width: int) -> None:
-    """Fills the textures of a ``"textured"`` model: walls and floor (a fixed
-    pattern, the same everywhere), and the pictures and meshes of ``objects``'
-    sprites for ``width``-wide frames (:func:`write_sprites`)."""
-    for name, texels in (("wall", palette.brick_texels()), ("floor", palette.tile_texels())):
-        _paint(model, name, texels)
+def paint_textures(model: mujoco.MjModel, room: palette.Room, objects: Sequence[ObjectGeom], width: int) -> None:
+    """Fills the textures of a ``"textured"`` model built for ``room``: walls and
+    floor (Freedoom's patterns, :func:`surface_texels`), and the pictures and
+    meshes of ``objects``' sprites for ``width``-wide frames (:func:`write_sprites`)."""
+    for name in ("wall", "floor"):
+        _paint(model, name, surface_texels(getattr(room, f"{name}_texture"), getattr(room, name))[0])
     write_sprites(model, objects, width)
 
 

@@ -1,10 +1,9 @@
-"""Doom's colours and light as ViZDoom draws the released maps, and the textures that carry them.
+"""Doom's colours and light as ViZDoom draws the released maps.
 
 Every number here was measured in ViZDoom against mjmaze's frames
 (``python tools/doom_frames.py --calibrate`` and ``--light``; docs/look.md):
 the rooms' mean colours, the columns' colours, the sprites' brightness,
-Doom's light over depth, and the grey texture patterns with the gains that
-keep each surface's mean colour. :mod:`mjmaze.mjcf` writes them into the
+and Doom's light over depth. :mod:`mjmaze.mjcf` writes them into the
 arena; :class:`mjmaze.look.DoomLight` applies the light.
 """
 
@@ -27,6 +26,9 @@ class Room:
     wall: tuple[float, float, float]
     floor: tuple[float, float, float]
     ceiling: tuple[float, float, float]
+    #: Freedoom's textures whose patterns the walls and floor show (:func:`mjmaze.sprites.surface`).
+    wall_texture: str = "STONE2"
+    floor_texture: str = "FLAT1_1"
 
 
 #: Labyrinth, Find-and-return and K-item: ``STONE2`` walls (grey), ``FLAT1_1``
@@ -36,7 +38,7 @@ STONE_ROOM = Room(wall=(0.33, 0.33, 0.33), floor=(0.52, 0.40, 0.19), ceiling=(0.
 #: The walls are every scenario's ``STONE2``: the released generator writes each
 #: side with it and replaces the base map's ``GSTONE1`` (green-grey) walls, which
 #: mjmaze drew until ``TwoColour-v2`` (docs/paper_agents.md).
-SLIME_ROOM = Room(wall=STONE_ROOM.wall, floor=(0.20, 0.40, 0.13), ceiling=(0.0, 0.0, 0.067))
+SLIME_ROOM = Room(wall=STONE_ROOM.wall, floor=(0.20, 0.40, 0.13), ceiling=(0.0, 0.0, 0.067), floor_texture="NUKAGE1")
 #: Doom's tall green and red columns (things 30, 32: Find-and-return's pillars,
 #: Two-colour's totem) as ViZDoom draws them, on a cylinder of their radius.
 TALL_GREEN_COLUMN_RGBA = (0.24, 0.51, 0.17, 1.0)
@@ -99,33 +101,6 @@ CEILING_LIGHT = DepthLight(
 _THING_GREY = tuple((north_south + east_west) / 2
                     for north_south, east_west in zip(NORTH_SOUTH_WALL_LIGHT.grey, EAST_WEST_WALL_LIGHT.grey))
 THING_LIGHT = DepthLight(_WALL_DEPTHS, _THING_GREY, 19.0)
-TEXTURE_TEXELS = 64  # per side of a texture; one texture covers 1 m x 1 m
-# 1 / the mean grey of each texture (see _brick_texels, _tile_texels).
-TEXTURE_GAIN = {"wall": 1.35, "floor": 1.6}
-
-
-def brick_texels() -> np.ndarray:
-    """Bricks 0.25 x 0.125 m in courses offset by half a brick, dark mortar, grain (grey, mean ~1/TEXTURE_GAIN)."""
-    n = TEXTURE_TEXELS
-    rng = np.random.default_rng(1)
-    rows, cols = np.mgrid[0:n, 0:n]
-    course = rows * 8 // n  # 8 courses per metre
-    shifted = (cols + (course % 2) * n // 8) % n  # every other course offset by half a brick
-    grey = rng.uniform(0.72, 1.0, size=(8, 4))[course, shifted * 4 // n] * rng.uniform(0.9, 1.0, size=(n, n))
-    grey[(rows % (n // 8) == 0) | (shifted % (n // 4) == 0)] = 0.4  # mortar
-    return _grey_to_rgb(grey)
-
-
-def tile_texels() -> np.ndarray:
-    """Tiles 0.5 m with dark joints and mottled grain (grey, mean ~1/TEXTURE_GAIN)."""
-    n = TEXTURE_TEXELS
-    rng = np.random.default_rng(2)
-    rows, cols = np.mgrid[0:n, 0:n]
-    tile = (rows * 2 // n) * 2 + cols * 2 // n
-    grey = rng.uniform(0.6, 0.8, size=4)[tile] * rng.uniform(0.85, 1.0, size=(n, n))
-    grey[(rows % (n // 2) == 0) | (cols % (n // 2) == 0)] = 0.35  # dark joints, as FLAT1_1's
-    return _grey_to_rgb(grey)
-
-
-def _grey_to_rgb(grey: np.ndarray) -> np.ndarray:
-    return np.repeat((np.clip(grey, 0, 1) * 255).astype(np.uint8)[..., None], 3, axis=2)
+#: Texels per metre of the walls' and floors' textures (Freedoom's, averaged
+#: over 2 x 2 map units; :func:`mjmaze.mjcf.surface_texels`).
+TEXTURE_TEXELS = 64

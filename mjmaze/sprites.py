@@ -1,14 +1,15 @@
-"""Freedoom 0.10.1's item sprites: the pictures the paper's agents saw, drawn as Doom draws them.
+"""Freedoom 0.10.1's pictures: the items' sprites and the rooms' textures the paper's agents saw.
 
 The paper's ViZDoom (1.1.4) drew Freedoom 0.10.1; its items are small
 pictures, not one colour, and the released agents tell them apart by their
 detail (docs/paper_agents.md: the K-item 4 agent took the right first item
 2 times in 64 with one-colour stand-ins, 62 with these pictures).
 
-``freedoom/sprites.wad`` holds those pictures unchanged, in Doom's own patch
-format with its palette and colormaps (Doom's light), taken from Freedoom
-0.10.1's ``freedoom2.wad`` by ``tools/freedoom_sprites.py`` (BSD licence:
-``freedoom/COPYING``). A :class:`Sprite` is one Doom thing's animation;
+``freedoom/pictures.wad`` holds those pictures unchanged, in Doom's own patch
+format with its palette and colormaps (Doom's light), and the released rooms'
+textures (:func:`surface`: the walls' ``STONE2``, its two patches, and the
+floors' flats), taken from Freedoom 0.10.1's ``freedoom2.wad`` by
+``tools/freedoom_pictures.py`` (BSD licence: ``freedoom/COPYING``). A :class:`Sprite` is one Doom thing's animation;
 :func:`textures` turns it into what mjmaze draws: each animation frame per
 depth bin, lit through Doom's colormap there and averaged as the released
 frames average it, on a flat mesh that turns to face the camera every frame
@@ -26,7 +27,7 @@ import numpy as np
 
 from mjmaze import palette
 
-SPRITE_WAD = "sprites.wad"
+FREEDOOM_WAD = "pictures.wad"
 #: Pictures per animation frame: the picture averaged over a square of this many pixels around
 #: each pixel (:func:`textures`), for a frame pixel that covers about as many.
 BOX_SIZES = (1, 2, 3, 4, 6, 8, 12)
@@ -113,21 +114,52 @@ def decode_patch(lump: bytes) -> tuple[np.ndarray, np.ndarray, tuple[int, int]]:
 
 @functools.lru_cache(maxsize=None)
 def _lumps() -> dict[str, bytes]:
-    return read_wad(importlib.resources.files("mjmaze").joinpath("freedoom", SPRITE_WAD).read_bytes())
+    return read_wad(importlib.resources.files("mjmaze").joinpath("freedoom", FREEDOOM_WAD).read_bytes())
+
+
+def _lump(name: str) -> bytes:
+    lumps = _lumps()
+    if name not in lumps:
+        raise KeyError(f"freedoom/{FREEDOOM_WAD} has no lump {name!r}; rebuild it with tools/freedoom_pictures.py")
+    return lumps[name]
 
 
 def picture_indices(name: str) -> tuple[np.ndarray, np.ndarray, tuple[int, int]]:
-    """Picture ``name`` (``"ARM1A0"``) of ``freedoom/sprites.wad``, decoded (:func:`decode_patch`)."""
-    lumps = _lumps()
-    if name not in lumps:
-        raise KeyError(f"freedoom/{SPRITE_WAD} has no picture {name!r}; rebuild it with tools/freedoom_sprites.py")
-    return decode_patch(lumps[name])
+    """Picture ``name`` (``"ARM1A0"``) of ``freedoom/pictures.wad``, decoded (:func:`decode_patch`)."""
+    return decode_patch(_lump(name))
 
 
 def picture(name: str) -> tuple[np.ndarray, np.ndarray, tuple[int, int]]:
     """Picture ``name`` in its palette colours: ``(rgb (h, w, 3) uint8, opaque, offsets)``."""
     indices, opaque, offsets = picture_indices(name)
     return palette_colours()[indices], opaque, offsets
+
+
+#: The released rooms' wall textures as Freedoom 0.10.1's ``TEXTURE1`` composes
+#: them from patches: ``(width, height, ((patch, x, y), ...))``, later patches
+#: drawn over earlier ones (``tools/freedoom_pictures.py --check`` compares).
+WALL_TEXTURES = {
+    "STONE2": (128, 128, (("W28_5", 0, 0), ("W28_5", 64, 64), ("W28_8", 0, 64), ("W28_8", 64, 0))),
+}
+#: The released rooms' floors: Doom's flats, 64 x 64 palette indices.
+FLATS = ("FLAT1_1", "NUKAGE1")
+
+
+def surface(name: str) -> np.ndarray:
+    """Texture ``name``, a wall texture (:data:`WALL_TEXTURES`) or a flat (:data:`FLATS`): ``(h, w, 3)`` uint8,
+    a map unit a pixel, row 0 at the top (a wall's) or north (a flat's: Doom's flats run x right, y up)."""
+    if name in FLATS:
+        return palette_colours()[np.frombuffer(_lump(name), dtype=np.uint8)[: 64 * 64].reshape(64, 64)]
+    if name not in WALL_TEXTURES:
+        raise KeyError(f"no texture {name!r}: mjmaze ships {sorted(WALL_TEXTURES)} and flats {FLATS}")
+    width, height, patches = WALL_TEXTURES[name]
+    rgb = np.zeros((height, width, 3), dtype=np.uint8)
+    for patch, x, y in patches:
+        colour, opaque, _ = picture(patch)
+        h, w = min(colour.shape[0], height - y), min(colour.shape[1], width - x)
+        region = rgb[y : y + h, x : x + w]
+        region[opaque[:h, :w]] = colour[:h, :w][opaque[:h, :w]]
+    return rgb
 
 
 def shape(sprite: Sprite) -> tuple[np.ndarray, tuple[int, int]]:
@@ -145,14 +177,14 @@ def shape(sprite: Sprite) -> tuple[np.ndarray, tuple[int, int]]:
 
 def palette_colours() -> np.ndarray:
     """Doom's palette, ``(256, 3)`` uint8 (Freedoom 0.10.1's ``PLAYPAL``, its first)."""
-    return np.frombuffer(_lumps()["PLAYPAL"][:768], np.uint8).reshape(256, 3)
+    return np.frombuffer(_lump("PLAYPAL")[:768], np.uint8).reshape(256, 3)
 
 
 @functools.lru_cache(maxsize=None)
 def colormaps() -> np.ndarray:
     """Doom's light, ``(NUM_COLORMAPS, 256)`` palette indices: colormap ``c`` draws index ``p`` as
     ``colormaps()[c, p]`` (0 the brightest; Freedoom 0.10.1's ``COLORMAP``)."""
-    return np.frombuffer(_lumps()["COLORMAP"], np.uint8)[: NUM_COLORMAPS * 256].reshape(NUM_COLORMAPS, 256)
+    return np.frombuffer(_lump("COLORMAP"), np.uint8)[: NUM_COLORMAPS * 256].reshape(NUM_COLORMAPS, 256)
 
 
 def colormap_of_depth(depth: np.ndarray) -> np.ndarray:

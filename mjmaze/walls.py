@@ -126,18 +126,25 @@ def wall_mesh_quads(h_walls: np.ndarray, v_walls: np.ndarray, cell_size: float) 
     return len(normals)
 
 
-def _box_mesh(boxes: np.ndarray, keep: np.ndarray | None = None):
+def _box_mesh(boxes: np.ndarray, keep: np.ndarray | None = None, spans: np.ndarray | None = None):
     """Vertices, faces, normals, face-normal indices and texture coordinates of
     boxes ``(x, y, hx, hy)`` standing on the floor, ``WALL_HEIGHT`` tall, as one mesh.
 
     ``keep`` ``(boxes, 5)`` says which quads to draw (sides y-, x+, y+, x-, then
     the top); default all.
 
-    Texture coordinates are world metres (along the wall, up the wall; ``x, y``
-    on the top), so a texel has the same size on every wall whatever its length.
+    Texture coordinates are metres, so a texel has the same size on every
+    wall, laid as Doom lays a wall texture on a line: across, from the end of
+    the line that is on the left as the side is seen, left to right; down, from
+    the top (Doom pegs a one-sided wall's texture to the ceiling). A box's line
+    along x spans ``spans[:, 0:2]`` (its ends' x), along y ``spans[:, 2:4]``
+    (default: the box's own ends): a piece of a longer line continues its
+    texture. The top: ``x, y``.
     """
     k = len(boxes)
     x, y, hx, hy = (boxes[:, i] for i in range(4))
+    if spans is None:
+        spans = np.stack([x - hx, x + hx, y - hy, y + hy], axis=1)
     corner_x = np.stack([x - hx, x + hx, x + hx, x - hx], axis=1)  # counter-clockwise from above
     corner_y = np.stack([y - hy, y - hy, y + hy, y + hy], axis=1)
     verts = np.zeros((k, _BOX_QUADS, 4, 3))
@@ -145,8 +152,10 @@ def _box_mesh(boxes: np.ndarray, keep: np.ndarray | None = None):
     for side, (a, b) in enumerate(_SIDE_CORNERS):  # quad: a bottom, b bottom, b top, a top
         for corner, (c, z) in enumerate(((a, 0.0), (b, 0.0), (b, WALL_HEIGHT), (a, WALL_HEIGHT))):
             verts[:, side, corner] = np.stack([corner_x[:, c], corner_y[:, c], np.full(k, z)], axis=1)
-            along = corner_x[:, c] if side % 2 == 0 else corner_y[:, c]  # sides 0, 2 run along x
-            texcoords[:, side, corner] = np.stack([along, np.full(k, z)], axis=1)
+            # Seen from outside, side y- runs left to right along +x, x+ along +y, y+ along -x, x- along -y.
+            along = (corner_x[:, c] - spans[:, 0], corner_y[:, c] - spans[:, 2],
+                     spans[:, 1] - corner_x[:, c], spans[:, 3] - corner_y[:, c])[side]
+            texcoords[:, side, corner] = np.stack([along, np.full(k, WALL_HEIGHT - z)], axis=1)
     for corner in range(4):  # the top
         verts[:, 4, corner] = np.stack([corner_x[:, corner], corner_y[:, corner], np.full(k, WALL_HEIGHT)], axis=1)
         texcoords[:, 4, corner] = np.stack([corner_x[:, corner], corner_y[:, corner]], axis=1)
@@ -239,29 +248,48 @@ def _pieces_per_segment(cell_size: float) -> int:
     return math.ceil((cell_size + 2 * WALL_THICKNESS) / MAX_PIECE_LENGTH)
 
 
-def wall_pieces(h_walls: np.ndarray, v_walls: np.ndarray, cell_size: float) -> tuple[np.ndarray, np.ndarray]:
-    """The visual walls: runs of walls cut into pieces of at most :data:`MAX_PIECE_LENGTH`.
+def wall_pieces(h_walls: np.ndarray, v_walls: np.ndarray,
+                cell_size: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The visual walls: runs of walls (:func:`wall_runs`) cut at the grid lines and into pieces of at
+    most :data:`MAX_PIECE_LENGTH`.
 
-    Returns boxes ``(x, y, hx, hy)`` and which of each box's quads to draw
+    Returns boxes ``(x, y, hx, hy)``, which of each box's quads to draw
     (``(boxes, 5)``: sides y-, x+, y+, x-, top): a cut between two pieces of a
-    run draws no end faces, which would be hidden inside the wall.
+    run draws no end faces, which would be hidden inside the wall; and each
+    box's texture spans (:func:`_box_mesh`) as Doom's lines run in the
+    released maps: an inner segment is a block of its own, one cell long
+    between grid lines, so its texture starts again at each grid line; the
+    outer wall is the edge of the maze's sector, one line a side.
     """
-    boxes, keep = [], []
-    for x, y, hx, hy in wall_runs(h_walls, v_walls, cell_size):
-        along_x = hx >= hy
-        length = 2 * (hx if along_x else hy)
-        count = math.ceil(length / MAX_PIECE_LENGTH - 1e-9)
-        half = length / count / 2
-        for i in range(count):
-            offset = -length / 2 + (2 * i + 1) * half
-            first, last = i == 0, i == count - 1
-            if along_x:
-                boxes.append((x + offset, y, half, hy))
-                keep.append((True, last, True, first, True))
-            else:
-                boxes.append((x, y + offset, hx, half))
-                keep.append((first, True, last, True, True))
-    return np.array(boxes, dtype=np.float64).reshape(-1, 4), np.array(keep, dtype=bool).reshape(-1, _BOX_QUADS)
+    n = h_walls.shape[1]
+    half = (n - 1) / 2
+    boxes, keep, spans = [], [], []
+    for horizontal, lines in ((True, h_walls), (False, v_walls.T)):
+        for line, flags in enumerate(lines):
+            outer = line in (0, n)
+            for start, stop in _runs(flags):
+                x, y, hx, hy = _box(horizontal, line, start, stop, n, cell_size)
+                (middle, length), (across, thick) = ((x, hx), (y, hy)) if horizontal else ((y, hy), (x, hx))
+                grid_lines = [(k - 0.5 - half) * cell_size for k in range(start + 1, stop)]
+                cuts = [middle - length, *grid_lines, middle + length]
+                for low, high in zip(cuts[:-1], cuts[1:]):
+                    line_low, line_high = (-n / 2 * cell_size, n / 2 * cell_size) if outer else (low, high)
+                    count = math.ceil((high - low) / MAX_PIECE_LENGTH - 1e-9)
+                    step = (high - low) / count
+                    for i in range(count):
+                        centre = low + (i + 0.5) * step
+                        first = low == cuts[0] and i == 0
+                        last = high == cuts[-1] and i == count - 1
+                        if horizontal:
+                            boxes.append((centre, across, step / 2, thick))
+                            keep.append((True, last, True, first, True))
+                            spans.append((line_low, line_high, across - thick, across + thick))
+                        else:
+                            boxes.append((across, centre, thick, step / 2))
+                            keep.append((first, True, last, True, True))
+                            spans.append((across - thick, across + thick, line_low, line_high))
+    return (np.array(boxes, dtype=np.float64).reshape(-1, 4), np.array(keep, dtype=bool).reshape(-1, _BOX_QUADS),
+            np.array(spans, dtype=np.float64).reshape(-1, 4))
 
 
 def _runs(flags: np.ndarray) -> list[tuple[int, int]]:

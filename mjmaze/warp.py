@@ -71,7 +71,7 @@ def build_model(task: core.MazeRules) -> tuple[mujoco.MjModel, np.ndarray, np.nd
     xml = mjcf.build_xml(layout.grid_size, layout.cell_size, task.objects, task.visual_style, task.room,
                          wall_layout_quads=quads, width=task.width)
     model = mujoco.MjModel.from_xml_string(xml)
-    mjcf.paint_textures(model, task.objects, task.width)
+    mjcf.paint_textures(model, task.room, task.objects, task.width)
     mjcf.set_ego_projection(model, task.width, task.height)
     for mesh, config in first_of_layout.items():
         mesh_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MESH, f"{walls.WALL_MESH}_{mesh}")

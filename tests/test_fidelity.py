@@ -50,7 +50,7 @@ def wall_brightness(env, distance):
     """Mean brightness of the frame's centre, facing the +x outer wall of an empty arena from ``distance`` m."""
     face = env.task.config.size * env.task.config.cell_size / 2  # the outer wall's face: the edge
     values = []
-    for y in np.linspace(-2.0, 2.0, 9):  # average over the brick pattern
+    for y in np.linspace(-2.0, 2.0, 9):  # average over the stone pattern
         place(env, face - distance, y, 0.0)
         frame = env.task.get_observation(env.physics)["pixels"].astype(float)
         values.append(frame[26:38, 46:66].mean())
@@ -77,13 +77,39 @@ def test_views_ninety_degrees_apart_differ_at_a_symmetric_spot(style, distinct):
 
 
 def test_texels_keep_their_size_on_walls_of_any_length():
-    # Texture coordinates are metres along the wall and up it, whatever the run.
+    # Texture coordinates are metres along the wall from its line's left end (as the
+    # side is seen) and down from its top, whatever the run: Doom's layout of a texture.
     boxes = np.array([[0.0, 0.0, 2.0, 0.0625], [5.0, 0.0, 0.5, 0.0625]])
     verts, _, _, _, texcoords = walls._box_mesh(boxes)
     for box in range(2):
-        quad = slice(box * 20, box * 20 + 4)  # the y- side: along x
-        assert np.allclose(texcoords[quad, 0], verts[quad, 0])
-        assert np.allclose(texcoords[quad, 1], verts[quad, 2])
+        quad = slice(box * 20, box * 20 + 4)  # the y- side: seen from -y, left to right along +x
+        assert np.allclose(texcoords[quad, 0], verts[quad, 0] - (boxes[box, 0] - boxes[box, 2]))
+        assert np.allclose(texcoords[quad, 1], walls.WALL_HEIGHT - verts[quad, 2])
+        quad = slice(box * 20 + 8, box * 20 + 12)  # the y+ side: seen from +y, left to right along -x
+        assert np.allclose(texcoords[quad, 0], (boxes[box, 0] + boxes[box, 2]) - verts[quad, 0])
+
+
+def test_wall_textures_start_again_at_each_grid_line_as_the_released_blocks_do():
+    # An inner run of three 1.25 m segments (K-item's cells): the released maps build
+    # each segment as a block of its own, so Doom's texture restarts at each grid line;
+    # the maze's outer wall is the sector's edge, one line a side.
+    h_walls = np.zeros((6, 5), dtype=bool)
+    h_walls[2, 1:4] = True
+    h_walls[0] = True  # the outer wall along the south edge
+    v_walls = np.zeros((5, 6), dtype=bool)
+    boxes, keep, spans = walls.wall_pieces(h_walls, v_walls, 1.25)
+    verts, _, _, _, texcoords = walls._box_mesh(boxes, keep, spans)
+    quads, coords = verts.reshape(-1, 4, 3), texcoords.reshape(-1, 4, 2)
+    half = walls.WALL_THICKNESS / 2
+    inner = np.isclose(quads[:, :, 1], (2 - 0.5 - 2) * 1.25 - half).all(axis=1)  # the run's south face
+    assert inner.sum() >= 3
+    grid_lines = (np.arange(1, 5) - 0.5 - 2) * 1.25
+    for quad, coord in zip(quads[inner], coords[inner]):
+        segment = int((quad[:, 0].mean() - grid_lines[0]) // 1.25)
+        assert np.allclose(coord[:, 0], quad[:, 0] - grid_lines[segment])
+    south = np.isclose(quads[:, :, 1], -5 * 1.25 / 2).all(axis=1)  # the outer wall's inside face
+    assert south.sum() >= 5  # seen from the north, left to right along -x from the maze's east corner
+    assert np.allclose(coords[south, :, 0], 5 * 1.25 / 2 - quads[south, :, 0])
 
 
 # -- pick-ups every tic ---------------------------------------------------------
