@@ -17,6 +17,9 @@ Arguments
 Metric
     ``success``: target found and return reached; ``target_found``.
 Version History
+    * v7 (2026-11-27): the walls and floor show Freedoom 0.10.1's own textures,
+      the released maps' ``STONE2`` and ``FLAT1_1`` (their grey pattern in the
+      room's calibrated colours), laid as Doom lays them (docs/look.md, "Rooms").
     * v6 (2026-11-27): the released mazes' geometry and Doom's squares: inner
       walls end at their grid lines, the outer wall's face is the maze's
       edge; the agent and pillars block as squares aligned with the map and
@@ -120,7 +123,7 @@ class FindReturn(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="find_return",
     task=FindReturn,
-    gym_id="mjmaze/FindReturn-v6",
+    gym_id="mjmaze/FindReturn-v7",
     seed_code=2,
     difficulty="size",
     difficulties=SIZES,

@@ -22,6 +22,9 @@ The collection order is item kind 1, then 2, ... by the released files' colour
 codes: green, red, blue, cyan, magenta, yellow, then two greys, which also
 differ in shape (:data:`KINDS`).
 Version History
+    * v9 (2026-11-27): the walls and floor show Freedoom 0.10.1's own textures,
+      the released maps' ``STONE2`` and ``FLAT1_1`` (their grey pattern in the
+      room's calibrated colours), laid as Doom lays them (docs/look.md, "Rooms").
     * v8 (2026-11-27): items lit as Doom lights sprites: a sector-lit picture
       through Doom's colormap at its depth (toward the palette's browns, not in
       proportion), a fullbright one (the armours' blink) in its own colours at
@@ -154,7 +157,7 @@ class KItem(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="k_item",
     task=KItem,
-    gym_id="mjmaze/KItem-v8",
+    gym_id="mjmaze/KItem-v9",
     seed_code=3,
     difficulty="num_items",
     difficulties=NUM_ITEMS,

@@ -16,6 +16,9 @@ Arguments
 Metric
     ``success``: whether the exit was reached (success rate = mean over episodes).
 Version History
+    * v10 (2026-11-27): the walls and floor show Freedoom 0.10.1's own textures,
+      the released maps' ``STONE2`` and ``FLAT1_1`` (their grey pattern in the
+      room's calibrated colours), laid as Doom lays them (docs/look.md, "Rooms").
     * v9 (2026-11-27): the exit (the green armour's picture) lit as Doom lights
       sprites: its sector-lit frame through Doom's colormap at its depth, its
       fullbright blink in its own colours at any depth; its rows below its
@@ -106,7 +109,7 @@ class Labyrinth(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="labyrinth",
     task=Labyrinth,
-    gym_id="mjmaze/Labyrinth-v9",
+    gym_id="mjmaze/Labyrinth-v10",
     seed_code=1,
     difficulty="size",
     difficulties=SIZES,

@@ -36,6 +36,10 @@ Arguments
 Metric
     ``duration``: tics survived (max 2100); also ``health`` and ``totem_green``.
 Version History
+    * v11 (2026-11-27): the walls and floor show Freedoom 0.10.1's own textures,
+      the released maps' ``STONE2`` and ``NUKAGE1`` (their grey pattern in the
+      room's calibrated colours), laid as Doom lays them (docs/look.md, "Rooms"); the
+      ceiling as the paper's Freedoom draws ``CEIL4_1``, half as bright.
     * v10 (2026-11-27): items lit as Doom lights sprites: a sector-lit picture
       through Doom's colormap at its depth (toward the palette's browns, not in
       proportion), a fullbright one (the armours' blink) in its own colours at
@@ -357,7 +361,7 @@ class TwoColour(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="two_colour",
     task=TwoColour,
-    gym_id="mjmaze/TwoColour-v10",
+    gym_id="mjmaze/TwoColour-v11",
     seed_code=4,
     difficulty="complexity",
     difficulties=COMPLEXITIES,
