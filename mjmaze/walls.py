@@ -272,14 +272,14 @@ def wall_pieces(h_walls: np.ndarray, v_walls: np.ndarray,
                 (middle, length), (across, thick) = ((x, hx), (y, hy)) if horizontal else ((y, hy), (x, hx))
                 grid_lines = [(k - 0.5 - half) * cell_size for k in range(start + 1, stop)]
                 cuts = [middle - length, *grid_lines, middle + length]
-                for low, high in zip(cuts[:-1], cuts[1:]):
+                for cut, (low, high) in enumerate(zip(cuts[:-1], cuts[1:])):
                     line_low, line_high = (-n / 2 * cell_size, n / 2 * cell_size) if outer else (low, high)
                     count = math.ceil((high - low) / MAX_PIECE_LENGTH - 1e-9)
                     step = (high - low) / count
                     for i in range(count):
                         centre = low + (i + 0.5) * step
-                        first = low == cuts[0] and i == 0
-                        last = high == cuts[-1] and i == count - 1
+                        first = cut == 0 and i == 0  # the run's ends draw their end faces
+                        last = cut == len(cuts) - 2 and i == count - 1
                         if horizontal:
                             boxes.append((centre, across, step / 2, thick))
                             keep.append((True, last, True, first, True))
