@@ -43,7 +43,12 @@ COLLISION_SUFFIX = "_collision"  # a colliding object's blocking twin (build_xml
 OVERHEAD_CAMERA = "overhead"
 OVERHEAD_HEIGHT = 10.0
 CEILING_GROUP = 2  # a geom group drawn in the agent's view, left out of top-down maps (mjmaze.render)
-CEILING_HALF_THICKNESS = 0.01
+#: The ceiling shows its colour whatever the light: it glows (emission) with a
+#: base colour this many times dimmer, so the lights add almost nothing (under
+#: 5%) and its few far-apart vertices cannot make it flash.
+CEILING_GLOW = 10.0
+#: The surfaces that show Freedoom's textures (:func:`surface_texels`), named as their materials.
+SURFACES = ("wall", "floor", "ceiling")
 EYE_HEIGHT = 0.32  # the ego camera's height (xml_templates/arena.xml)
 
 @dataclasses.dataclass(frozen=True)
@@ -141,12 +146,8 @@ def build_xml(
     for name in ("wall", "floor"):
         ET.SubElement(asset, "material", name=name, rgba=" ".join(f"{v:.3f}" for v in getattr(room, name)) + " 1",
                       specular="0", shininess="0", reflectance="0")
-    # The ceiling shows its colour whatever the light: it glows (emission) with
-    # a dim base colour, so the lights add almost nothing (under 5%) and its few
-    # far-apart vertices cannot make it flash.
-    glow = 10.0
-    ET.SubElement(asset, "material", name="ceiling", rgba=" ".join(f"{v / glow:.4f}" for v in room.ceiling) + " 1",
-                  emission=f"{glow - palette.AMBIENT}", specular="0", shininess="0", reflectance="0")
+    ET.SubElement(asset, "material", name="ceiling", rgba=" ".join(f"{v:.4f}" for v in _material_colour(room, "ceiling")) + " 1",
+                  emission=f"{CEILING_GLOW - palette.AMBIENT}", specular="0", shininess="0", reflectance="0")
     if visual_style == "textured":
         _add_textures(root, room)
     segments = walls.wall_segments(grid_size, cell_size)
@@ -171,12 +172,14 @@ def build_xml(
         worldbody, "geom", name="floor", type="plane", material="floor",
         size=f"{half_extent} {half_extent} {LIT_QUAD}",
     )
-    # The ceiling, Doom's 128 units up: a thin box (one quad per face), group 2,
-    # which top-down maps leave out. A lit plane grid like the floor's cost
-    # llvmpipe 48 us a frame, this 18 (README, "Speed").
+    # The ceiling, Doom's 128 units up: a plane turned to face down (one quad:
+    # it glows, so no lit grid), group 2, which top-down maps leave out. A
+    # plane, not a box: MuJoCo's GL and MuJoCo Warp lay a plane's texture alike
+    # (a box's underside they lay half a tile apart), and both lay it on the
+    # map as on the floor.
     ET.SubElement(
-        worldbody, "geom", name="ceiling", type="box", material="ceiling", group=str(CEILING_GROUP),
-        size=f"{half_extent} {half_extent} {CEILING_HALF_THICKNESS}", pos=f"0 0 {walls.WALL_HEIGHT + CEILING_HALF_THICKNESS}",
+        worldbody, "geom", name="ceiling", type="plane", material="ceiling", group=str(CEILING_GROUP),
+        size=f"{half_extent} {half_extent} {2 * half_extent}", pos=f"0 0 {walls.WALL_HEIGHT}", quat="0 1 0 0",
     )
     # An orthographic camera looking straight down at the whole arena, image up
     # = +y, for top-down maps (mjmaze.viz); fovy is then the view's height in metres.
@@ -250,9 +253,9 @@ def set_ego_projection(model: mujoco.MjModel, width: int, height: int) -> None:
 
 
 def _add_textures(root: ET.Element, room: palette.Room) -> None:
-    """Textures on the wall and floor materials, and GL's even light (Doom's comes after)."""
+    """Textures on the wall, floor and ceiling materials, and GL's even light (Doom's comes after)."""
     asset = root.find("asset")
-    for name in ("wall", "floor"):
+    for name in SURFACES:
         # builtin="flat" only sizes the texture: paint_textures fills it.
         ET.SubElement(
             asset, "texture", name=name, type="2d", builtin="flat",
@@ -263,14 +266,22 @@ def _add_textures(root: ET.Element, room: palette.Room) -> None:
         # maps, drawn without textures, keep its hue).
         material = asset.find(f"material[@name='{name}']")
         material.set("texture", name)
-        colour = getattr(room, name)
+        colour = _material_colour(room, name)
         _, gain = surface_texels(getattr(room, f"{name}_texture"), colour)
         material.set("rgba", " ".join(f"{min(v * gain, 1.0):.4f}" for v in colour) + " 1")
-    # The floor repeats its texture once per metre; the wall mesh carries
-    # texture coordinates in metres.
-    asset.find("material[@name='floor']").set("texuniform", "true")
-    asset.find("material[@name='floor']").set("texrepeat", "1 1")
+    # The floor and the ceiling show their textures once per metre: a uniform
+    # texture repeats once per 2 / texrepeat metres on a plane (in MuJoCo's GL
+    # and MuJoCo Warp alike). The wall mesh carries texture coordinates in metres.
+    for name in ("floor", "ceiling"):
+        asset.find(f"material[@name='{name}']").set("texuniform", "true")
+        asset.find(f"material[@name='{name}']").set("texrepeat", "2 2")
     _ambient_light(root)
+
+
+def _material_colour(room: palette.Room, surface: str) -> tuple[float, ...]:
+    """The colour of ``surface``'s material before its texture: the room's, the ceiling's dimmed by its glow."""
+    colour = getattr(room, surface)
+    return tuple(v / CEILING_GLOW for v in colour) if surface == "ceiling" else colour
 
 
 @functools.lru_cache(maxsize=None)
@@ -288,10 +299,6 @@ def surface_texels(texture: str, colour: tuple[float, float, float]) -> tuple[np
     material's colour under 1 (then the brightest few saturate).
     """
     grey = sprites.surface(texture).astype(np.float64).mean(axis=2)
-    if texture in sprites.FLATS:
-        # A flat's rows run along Doom's y; MuJoCo's uniform plane texture runs its rows along x
-        # (of the 8 ways to lay FLAT1_1, this one's frames are nearest ViZDoom's at 4 poses).
-        grey = grey.T
     metre = round(1 / MAP_UNIT)
     grey = np.tile(grey, (-(-metre // grey.shape[0]), -(-metre // grey.shape[1])))[:metre, :metre]
     fold = metre // palette.TEXTURE_TEXELS
@@ -317,12 +324,36 @@ def _ambient_light(root: ET.Element) -> None:
 
 
 def paint_textures(model: mujoco.MjModel, room: palette.Room, objects: Sequence[ObjectGeom], width: int) -> None:
-    """Fills the textures of a ``"textured"`` model built for ``room``: walls and
-    floor (Freedoom's patterns, :func:`surface_texels`), and the pictures and
+    """Fills the textures of a ``"textured"`` model built for ``room``: walls,
+    floor and ceiling (Freedoom's patterns, :func:`surface_texels`), and the pictures and
     meshes of ``objects``' sprites for ``width``-wide frames (:func:`write_sprites`)."""
-    for name in ("wall", "floor"):
-        _paint(model, name, surface_texels(getattr(room, f"{name}_texture"), getattr(room, name))[0])
+    for name in SURFACES:
+        texels = surface_texels(getattr(room, f"{name}_texture"), _material_colour(room, name))[0]
+        if name != "wall":
+            texels = _laid_on_the_map(texels, model.geom_size[_geom(model, name)][:2], turned_over=name == "ceiling")
+        _paint(model, name, texels)
     write_sprites(model, objects, width)
+
+
+def _laid_on_the_map(texels: np.ndarray, half_size, turned_over: bool) -> np.ndarray:
+    """A flat's metre of ``texels`` (row 0 north) arranged so that a plane of ``half_size`` (x, y) centred on
+    the origin, facing up or ``turned_over`` (the ceiling), shows it as Doom lays flats on the map.
+
+    Doom lays a flat from the map's origin, column along x and row along -y
+    (R_MapPlane); the maze is centred on the origin, its grid lines on whole
+    flats as in the released maps. A uniform plane texture in MuJoCo (GL
+    and Warp alike) starts at the plane's corner (-x, +y) with its rows
+    along the plane's -y, which the turned-over ceiling's rows run along +y.
+    """
+    texel_count = len(texels)
+    index = np.arange(texel_count)
+    shift_x, shift_y = (round(h * texel_count) for h in half_size)
+    rows = (shift_y - index) if turned_over else (index - shift_y)
+    return texels[rows[:, None] % texel_count, (index - shift_x)[None, :] % texel_count]
+
+
+def _geom(model: mujoco.MjModel, name: str) -> int:
+    return mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name)
 
 
 def _paint(model: mujoco.MjModel, texture_name: str, texels: np.ndarray) -> None:

@@ -26,9 +26,10 @@ class Room:
     wall: tuple[float, float, float]
     floor: tuple[float, float, float]
     ceiling: tuple[float, float, float]
-    #: Freedoom's textures whose patterns the walls and floor show (:func:`mjmaze.sprites.surface`).
+    #: Freedoom's textures whose patterns the walls, floor and ceiling show (:func:`mjmaze.sprites.surface`).
     wall_texture: str = "STONE2"
     floor_texture: str = "FLAT1_1"
+    ceiling_texture: str = "MFLR8_1"
 
 
 #: Labyrinth, Find-and-return and K-item: ``STONE2`` walls (grey), ``FLAT1_1``
@@ -40,7 +41,8 @@ STONE_ROOM = Room(wall=(0.33, 0.33, 0.33), floor=(0.52, 0.40, 0.19), ceiling=(0.
 #: mjmaze drew until ``TwoColour-v2`` (docs/paper_agents.md). The ceiling is
 #: the paper's Freedoom 0.10.1 ``CEIL4_1`` (blue 9 in ViZDoom's top rows);
 #: until ``TwoColour-v10`` it was 0.13's, twice as bright (blue 17).
-SLIME_ROOM = Room(wall=STONE_ROOM.wall, floor=(0.20, 0.40, 0.13), ceiling=(0.0, 0.0, 0.035), floor_texture="NUKAGE1")
+SLIME_ROOM = Room(wall=STONE_ROOM.wall, floor=(0.20, 0.40, 0.13), ceiling=(0.0, 0.0, 0.035),
+                  floor_texture="NUKAGE1", ceiling_texture="CEIL4_1")
 #: Doom's tall green and red columns (things 30, 32: Find-and-return's pillars,
 #: Two-colour's totem) as ViZDoom draws them, on a cylinder of their radius.
 TALL_GREEN_COLUMN_RGBA = (0.24, 0.51, 0.17, 1.0)

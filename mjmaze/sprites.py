@@ -141,8 +141,8 @@ def picture(name: str) -> tuple[np.ndarray, np.ndarray, tuple[int, int]]:
 WALL_TEXTURES = {
     "STONE2": (128, 128, (("W28_5", 0, 0), ("W28_5", 64, 64), ("W28_8", 0, 64), ("W28_8", 64, 0))),
 }
-#: The released rooms' floors: Doom's flats, 64 x 64 palette indices.
-FLATS = ("FLAT1_1", "NUKAGE1")
+#: The released rooms' floors and ceilings: Doom's flats, 64 x 64 palette indices.
+FLATS = ("FLAT1_1", "NUKAGE1", "MFLR8_1", "CEIL4_1")
 
 
 def surface(name: str) -> np.ndarray:

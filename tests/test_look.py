@@ -107,7 +107,8 @@ def test_a_wall_stands_as_tall_in_the_frame_as_in_vizdooms(distance, doom_rows):
     centre = frame_at(env, env.task.config.size - distance, 0.0, 0.0)[:, 50:62]
     env.task.close()
     red, green, blue = (centre[..., k].astype(int) for k in range(3))
-    wall = (green - red < 8) & (blue - red < 6)  # neither the green floor nor the blue ceiling
+    # Neither the green floor nor the blue ceiling (its red is 0 everywhere, its darkest texels black).
+    wall = (green - red < 8) & (blue - red < 6) & (red > 3)
     # The wall's rows: the run through the frame's middle (the slime's darkest texels look grey too).
     above = np.argmin(wall[31::-1], axis=0)  # wall rows from row 31 up, per column
     below = np.argmin(wall[32:], axis=0)
