@@ -323,33 +323,42 @@ def _ambient_light(root: ET.Element) -> None:
     headlight.set("diffuse", "0 0 0")
 
 
-def paint_textures(model: mujoco.MjModel, room: palette.Room, objects: Sequence[ObjectGeom], width: int) -> None:
+def paint_textures(model: mujoco.MjModel, room: palette.Room, objects: Sequence[ObjectGeom], width: int,
+                   cell_size: float) -> None:
     """Fills the textures of a ``"textured"`` model built for ``room``: walls,
-    floor and ceiling (Freedoom's patterns, :func:`surface_texels`), and the pictures and
-    meshes of ``objects``' sprites for ``width``-wide frames (:func:`write_sprites`)."""
+    floor and ceiling (Freedoom's patterns, :func:`surface_texels`; the flats
+    laid for a maze of ``cell_size`` cells as the released maps lay them), and
+    the pictures and meshes of ``objects``' sprites for ``width``-wide frames
+    (:func:`write_sprites`)."""
     for name in SURFACES:
         texels = surface_texels(getattr(room, f"{name}_texture"), _material_colour(room, name))[0]
         if name != "wall":
-            texels = _laid_on_the_map(texels, model.geom_size[_geom(model, name)][:2], turned_over=name == "ceiling")
+            texels = _laid_on_the_map(texels, model.geom_size[_geom(model, name)][:2], cell_size / 2,
+                                      turned_over=name == "ceiling")
         _paint(model, name, texels)
     write_sprites(model, objects, width)
 
 
-def _laid_on_the_map(texels: np.ndarray, half_size, turned_over: bool) -> np.ndarray:
+def _laid_on_the_map(texels: np.ndarray, half_size, origin: float, turned_over: bool) -> np.ndarray:
     """A flat's metre of ``texels`` (row 0 north) arranged so that a plane of ``half_size`` (x, y) centred on
-    the origin, facing up or ``turned_over`` (the ceiling), shows it as Doom lays flats on the map.
+    mjmaze's origin, facing up or ``turned_over`` (the ceiling), shows it as Doom lays flats on a map whose
+    origin is at (``origin``, ``origin``) metres.
 
-    Doom lays a flat from the map's origin, column along x and row along -y
-    (R_MapPlane); the maze is centred on the origin, its grid lines on whole
-    flats as in the released maps. A uniform plane texture in MuJoCo (GL
-    and Warp alike) starts at the plane's corner (-x, +y) with its rows
-    along the plane's -y, which the turned-over ceiling's rows run along +y.
+    Doom lays a flat from the map's origin, columns along x and rows along -y
+    (R_MapPlane). The released generators put the map's origin half a cell
+    south-west of the maze's centre (their mazes span -cell/2 +- size x
+    cell/2; mjmaze centres its own), which moves K-item's 160-unit cells'
+    flats by 16 units. A uniform plane texture in MuJoCo (GL and Warp alike)
+    starts at the plane's corner (-x, +y), its rows along the plane's -y: the
+    turned-over ceiling's run along the map's +y.
     """
-    texel_count = len(texels)
-    index = np.arange(texel_count)
-    shift_x, shift_y = (round(h * texel_count) for h in half_size)
-    rows = (shift_y - index) if turned_over else (index - shift_y)
-    return texels[rows[:, None] % texel_count, (index - shift_x)[None, :] % texel_count]
+    count = len(texels)  # a metre's texels
+    index = np.arange(count)
+    half_x, half_y = half_size
+    columns = index - round((half_x + origin) * count)
+    # Turned over, texel row r spans the map's (r - 1, r] texels south of an edge, not [r, r + 1).
+    rows = round((half_y + origin) * count) - 1 - index if turned_over else index - round((half_y - origin) * count)
+    return texels[rows[:, None] % count, columns[None, :] % count]
 
 
 def _geom(model: mujoco.MjModel, name: str) -> int:

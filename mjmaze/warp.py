@@ -4,7 +4,7 @@
 gymnasium vector env whose observations, rewards, flags and ``info`` are torch
 tensors on ``device``; reached from the registry by one word::
 
-    envs = gymnasium.make_vec("mjmaze/Labyrinth-v10", num_envs=4096,
+    envs = gymnasium.make_vec("mjmaze/Labyrinth-v11", num_envs=4096,
                               vectorization_mode="vector_entry_point", backend="warp", size=9)
 
 It plays the same task as the CPU envs: the same configurations (splits,
@@ -71,7 +71,7 @@ def build_model(task: core.MazeRules) -> tuple[mujoco.MjModel, np.ndarray, np.nd
     xml = mjcf.build_xml(layout.grid_size, layout.cell_size, task.objects, task.visual_style, task.room,
                          wall_layout_quads=quads, width=task.width)
     model = mujoco.MjModel.from_xml_string(xml)
-    mjcf.paint_textures(model, task.room, task.objects, task.width)
+    mjcf.paint_textures(model, task.room, task.objects, task.width, layout.cell_size)
     mjcf.set_ego_projection(model, task.width, task.height)
     for mesh, config in first_of_layout.items():
         mesh_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MESH, f"{walls.WALL_MESH}_{mesh}")

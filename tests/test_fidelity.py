@@ -8,12 +8,14 @@ the released generator's Two-colour layouts import and play.
 
 import json
 import math
+import xml.etree.ElementTree as ET
 
+import mujoco
 import numpy as np
 import pytest
 
 import mjmaze
-from mjmaze import layouts, walls
+from mjmaze import layouts, mjcf, palette, render, sprites, walls
 from mjmaze.tasks import base, find_return, k_item, two_colour
 
 from conftest import FORWARD, place
@@ -110,6 +112,56 @@ def test_wall_textures_start_again_at_each_grid_line_as_the_released_blocks_do()
     south = np.isclose(quads[:, :, 1], -5 * 1.25 / 2).all(axis=1)  # the outer wall's inside face
     assert south.sum() >= 5  # seen from the north, left to right along -x from the maze's east corner
     assert np.allclose(coords[south, :, 0], 5 * 1.25 / 2 - quads[south, :, 0])
+
+
+def flat_views(task, centre, extent=1.0, pixels=128):
+    """GL's frames (before Doom's light) of ``task``'s floor from above and ceiling from below: orthographic
+    views of an ``extent``-metre square around ``centre``, image right along +x, image up along +y."""
+    root = ET.fromstring(mjcf.build_xml(task.layout.grid_size, task.layout.cell_size, room=task.room, width=task.width))
+    x, y = centre
+    for name, z, axes in (("down", 0.5, "1 0 0 0 1 0"), ("up", 0.5, "1 0 0 0 -1 0")):
+        ET.SubElement(root.find("worldbody"), "camera", name=name, pos=f"{x} {y} {z}", xyaxes=axes,
+                      projection="orthographic", fovy=str(extent))
+    root.find("visual/global").attrib.update(offwidth=str(pixels), offheight=str(pixels))
+    model = mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
+    mjcf.paint_textures(model, task.room, (), task.width, task.layout.cell_size)
+    # Whiter, so GL draws the texels themselves rather than a few dim grey levels
+    # (GL's colour: the material's times its emission plus the ambient light).
+    for name in ("floor", "ceiling"):
+        material = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MATERIAL, name)
+        model.mat_rgba[material, :3] = min(1.0, 1 / (model.mat_emission[material] + palette.AMBIENT))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    views = [render.EgoRenderer(model, camera, pixels, pixels).render(data).astype(np.float64).mean(axis=2)
+             for camera in ("down", "up")]
+    return views[0], views[1][::-1]  # the ceiling's view turned to image up along +y
+
+
+@pytest.mark.parametrize("scenario, kwargs", [("labyrinth", {"size": 5}), ("k_item", {"num_items": 2}),
+                                              ("two_colour", {"complexity": 1})])
+def test_floor_and_ceiling_show_their_flats_laid_as_in_the_released_maps(scenario, kwargs):
+    # Doom lays a flat from the map's origin, a texel per map unit, its columns along x and its
+    # rows along -y; the released maps put their origin half a cell south-west of the maze's
+    # centre (K-item's 160-unit cells move its flats 16 units from a centred maze's).
+    env = load(scenario, **kwargs)
+    task = env.task
+    centre, extent, pixels = (0.3, -0.2), 1.0, 128
+    floor, ceiling = flat_views(task, centre, extent, pixels)
+    env.close()
+    offsets = (np.arange(pixels) + 0.5 - pixels / 2) * extent / pixels
+    map_x = (centre[0] + offsets[None, :] - task.layout.cell_size / 2) * 128  # map units
+    map_y = (centre[1] - offsets[:, None] - task.layout.cell_size / 2) * 128
+    for view, texture in ((floor, task.room.floor_texture), (ceiling, task.room.ceiling_texture)):
+        # mjmaze draws a flat in texels of 2 x 2 map units (mjcf.surface_texels).
+        grey = sprites.surface(texture).astype(np.float64).mean(axis=2).reshape(32, 2, 32, 2).mean(axis=(1, 3))
+
+        def laid(x, y):  # the texel Doom shows at map (x, y)
+            return grey[np.floor(-y / 2).astype(int) % 32, np.floor(x / 2).astype(int) % 32]
+
+        assert np.corrcoef(view.ravel(), laid(map_x, map_y).ravel())[0, 1] > 0.9, texture
+        # A texel off, transposed, or twice as large (mjmaze's floors before Labyrinth-v11) matches far worse.
+        for wrong in (laid(map_x + 2, map_y - 2), laid(-map_y, -map_x), laid(map_x / 2, map_y / 2)):
+            assert np.corrcoef(view.ravel(), wrong.ravel())[0, 1] < 0.7, texture
 
 
 # -- pick-ups every tic ---------------------------------------------------------

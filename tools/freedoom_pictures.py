@@ -8,7 +8,7 @@ The paper's agents saw Freedoom 0.10.1 (``tools/paper_agents_vizdoom.py``
 fetches its ``freedoom2.wad`` and checks it). mjmaze ships only the pictures
 of the eight things the released generators place as items, every frame of
 their animations (:data:`mjmaze.sprites.SPRITES`), the patches of the
-released walls' texture and the released floors' flats
+released walls' texture and the released floors' and ceilings' flats
 (:data:`mjmaze.sprites.WALL_TEXTURES`, :data:`mjmaze.sprites.FLATS`), the
 palette and the colormaps (Doom's light), copied byte for byte into a small
 PWAD, with Freedoom's licence beside it. ``--check`` also compares each wall

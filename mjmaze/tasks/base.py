@@ -283,7 +283,7 @@ def make_environment(task: MazeTask, environment_kwargs: dict | None = None) -> 
     xml = mjcf.build_xml(task.layout.grid_size, task.layout.cell_size, task.objects, task.visual_style, task.room,
                          width=task.width)
     physics = MazePhysics.from_xml_string(xml)
-    mjcf.paint_textures(physics.model.ptr, task.room, task.objects, task.width)
+    mjcf.paint_textures(physics.model.ptr, task.room, task.objects, task.width, task.layout.cell_size)
     kwargs = dict(n_sub_steps=TICS_PER_STEP, legacy_step=False)
     kwargs.update(environment_kwargs or {})
     return control.Environment(physics, task, **kwargs)

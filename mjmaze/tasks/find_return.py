@@ -17,6 +17,10 @@ Arguments
 Metric
     ``success``: target found and return reached; ``target_found``.
 Version History
+    * v8 (2026-11-27): the floor's flat laid as Doom lays flats: a 64-unit
+      tile every half metre (v7 drew it twice as large), columns along x and
+      rows along -y from the map's origin; the ceiling shows ``MFLR8_1`` the same
+      way, where it was one colour (docs/look.md, "Rooms").
     * v7 (2026-11-27): the walls and floor show Freedoom 0.10.1's own textures,
       the released maps' ``STONE2`` and ``FLAT1_1`` (their grey pattern in the
       room's calibrated colours), laid as Doom lays them (docs/look.md, "Rooms").
@@ -123,7 +127,7 @@ class FindReturn(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="find_return",
     task=FindReturn,
-    gym_id="mjmaze/FindReturn-v7",
+    gym_id="mjmaze/FindReturn-v8",
     seed_code=2,
     difficulty="size",
     difficulties=SIZES,

@@ -22,6 +22,10 @@ The collection order is item kind 1, then 2, ... by the released files' colour
 codes: green, red, blue, cyan, magenta, yellow, then two greys, which also
 differ in shape (:data:`KINDS`).
 Version History
+    * v10 (2026-11-27): the floor's flat laid as Doom lays flats: a 64-unit
+      tile every half metre (v9 drew it twice as large), columns along x and
+      rows along -y from the map's origin; the ceiling shows ``MFLR8_1`` the same
+      way, where it was one colour (docs/look.md, "Rooms").
     * v9 (2026-11-27): the walls and floor show Freedoom 0.10.1's own textures,
       the released maps' ``STONE2`` and ``FLAT1_1`` (their grey pattern in the
       room's calibrated colours), laid as Doom lays them (docs/look.md, "Rooms").
@@ -157,7 +161,7 @@ class KItem(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="k_item",
     task=KItem,
-    gym_id="mjmaze/KItem-v9",
+    gym_id="mjmaze/KItem-v10",
     seed_code=3,
     difficulty="num_items",
     difficulties=NUM_ITEMS,

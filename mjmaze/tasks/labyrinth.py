@@ -16,6 +16,10 @@ Arguments
 Metric
     ``success``: whether the exit was reached (success rate = mean over episodes).
 Version History
+    * v11 (2026-11-27): the floor's flat laid as Doom lays flats: a 64-unit
+      tile every half metre (v10 drew it twice as large), columns along x and
+      rows along -y from the map's origin; the ceiling shows ``MFLR8_1`` the same
+      way, where it was one colour (docs/look.md, "Rooms").
     * v10 (2026-11-27): the walls and floor show Freedoom 0.10.1's own textures,
       the released maps' ``STONE2`` and ``FLAT1_1`` (their grey pattern in the
       room's calibrated colours), laid as Doom lays them (docs/look.md, "Rooms").
@@ -109,7 +113,7 @@ class Labyrinth(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="labyrinth",
     task=Labyrinth,
-    gym_id="mjmaze/Labyrinth-v10",
+    gym_id="mjmaze/Labyrinth-v11",
     seed_code=1,
     difficulty="size",
     difficulties=SIZES,

@@ -36,6 +36,10 @@ Arguments
 Metric
     ``duration``: tics survived (max 2100); also ``health`` and ``totem_green``.
 Version History
+    * v12 (2026-11-27): the floor's flat laid as Doom lays flats: a 64-unit
+      tile every half metre (v11 drew it twice as large), columns along x and
+      rows along -y from the map's origin; the ceiling shows ``CEIL4_1`` the same
+      way, where it was one colour (docs/look.md, "Rooms").
     * v11 (2026-11-27): the walls and floor show Freedoom 0.10.1's own textures,
       the released maps' ``STONE2`` and ``NUKAGE1`` (their grey pattern in the
       room's calibrated colours), laid as Doom lays them (docs/look.md, "Rooms"); the
@@ -361,7 +365,7 @@ class TwoColour(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="two_colour",
     task=TwoColour,
-    gym_id="mjmaze/TwoColour-v11",
+    gym_id="mjmaze/TwoColour-v12",
     seed_code=4,
     difficulty="complexity",
     difficulties=COMPLEXITIES,
