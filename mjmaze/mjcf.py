@@ -175,8 +175,7 @@ def build_xml(
     # The ceiling, Doom's 128 units up: a plane turned to face down (one quad:
     # it glows, so no lit grid), group 2, which top-down maps leave out. A
     # plane, not a box: MuJoCo's GL and MuJoCo Warp lay a plane's texture alike
-    # (a box's underside they lay half a tile apart), and both lay it on the
-    # map as on the floor.
+    # (a box's underside at different offsets), as on the floor.
     ET.SubElement(
         worldbody, "geom", name="ceiling", type="plane", material="ceiling", group=str(CEILING_GROUP),
         size=f"{half_extent} {half_extent} {2 * half_extent}", pos=f"0 0 {walls.WALL_HEIGHT}", quat="0 1 0 0",
@@ -356,7 +355,7 @@ def _laid_on_the_map(texels: np.ndarray, half_size, origin: float, turned_over: 
     index = np.arange(count)
     half_x, half_y = half_size
     columns = index - round((half_x + origin) * count)
-    # Turned over, texel row r spans the map's (r - 1, r] texels south of an edge, not [r, r + 1).
+    # Turned over, the rows count the other way: each texel's span begins one texel further on.
     rows = round((half_y + origin) * count) - 1 - index if turned_over else index - round((half_y - origin) * count)
     return texels[rows[:, None] % count, columns[None, :] % count]
 
