@@ -149,8 +149,8 @@ def test_floor_and_ceiling_show_their_flats_laid_as_in_the_released_maps(scenari
     floor, ceiling = flat_views(task, centre, extent, pixels)
     env.close()
     offsets = (np.arange(pixels) + 0.5 - pixels / 2) * extent / pixels
-    map_x = (centre[0] + offsets[None, :] - task.layout.cell_size / 2) * 128  # map units
-    map_y = (centre[1] - offsets[:, None] - task.layout.cell_size / 2) * 128
+    map_x = (centre[0] + offsets[None, :] - task.layout.cell_size / 2) / mjcf.MAP_UNIT  # map units
+    map_y = (centre[1] - offsets[:, None] - task.layout.cell_size / 2) / mjcf.MAP_UNIT
     for view, texture in ((floor, task.room.floor_texture), (ceiling, task.room.ceiling_texture)):
         # mjmaze draws a flat in texels of 2 x 2 map units (mjcf.surface_texels).
         grey = sprites.surface(texture).astype(np.float64).mean(axis=2).reshape(32, 2, 32, 2).mean(axis=(1, 3))
