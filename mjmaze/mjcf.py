@@ -272,8 +272,7 @@ def _add_textures(root: ET.Element, room: palette.Room) -> None:
     # texture repeats once per 2 / texrepeat metres on a plane (in MuJoCo's GL
     # and MuJoCo Warp alike). The wall mesh carries texture coordinates in metres.
     for name in ("floor", "ceiling"):
-        asset.find(f"material[@name='{name}']").set("texuniform", "true")
-        asset.find(f"material[@name='{name}']").set("texrepeat", "2 2")
+        asset.find(f"material[@name='{name}']").attrib.update(texuniform="true", texrepeat="2 2")
     _ambient_light(root)
 
 
@@ -332,8 +331,8 @@ def paint_textures(model: mujoco.MjModel, room: palette.Room, objects: Sequence[
     for name in SURFACES:
         texels = surface_texels(getattr(room, f"{name}_texture"), _material_colour(room, name))[0]
         if name != "wall":
-            texels = _laid_on_the_map(texels, model.geom_size[_geom(model, name)][:2], cell_size / 2,
-                                      turned_over=name == "ceiling")
+            plane = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name)
+            texels = _laid_on_the_map(texels, model.geom_size[plane][:2], cell_size / 2, turned_over=name == "ceiling")
         _paint(model, name, texels)
     write_sprites(model, objects, width)
 
@@ -358,10 +357,6 @@ def _laid_on_the_map(texels: np.ndarray, half_size, origin: float, turned_over: 
     # Turned over, the rows count the other way: each texel's span begins one texel further on.
     rows = round((half_y + origin) * count) - 1 - index if turned_over else index - round((half_y - origin) * count)
     return texels[rows[:, None] % count, columns[None, :] % count]
-
-
-def _geom(model: mujoco.MjModel, name: str) -> int:
-    return mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name)
 
 
 def _paint(model: mujoco.MjModel, texture_name: str, texels: np.ndarray) -> None:
