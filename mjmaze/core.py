@@ -15,6 +15,7 @@ Warp backend each move their arena to match the state the rules keep
 from __future__ import annotations
 
 import abc
+import functools
 import math
 import os
 from collections.abc import Sequence
@@ -30,6 +31,9 @@ TICS_PER_SECOND = 35
 TICS_PER_STEP = 4
 STEPS_PER_SECOND = TICS_PER_SECOND / TICS_PER_STEP  # real time: 8.75 observations a second
 EPISODE_STEPS = 525  # 2100 tics
+#: ViZDoom's episode clock (``GameState.tic``) at the first observation; an agent step adds
+#: ``TICS_PER_STEP``. Things' animations run on it (:meth:`MazeRules.animation_start`).
+FIRST_OBSERVATION_TIC = 1
 PICKUP_RADIUS = rules.PICKUP_RADIUS
 AGENT_RADIUS = 0.125
 
@@ -61,6 +65,7 @@ class EpisodeState(TypedDict, total=False):
     key: Any  #: ``(B,)`` int64: the episode's key for :func:`mjmaze.rules.uniform`
     steps: Any  #: ``(B,)`` int64: agent steps taken
     episode_return: Any  #: ``(B,)`` float64: the return so far
+    animation_start: Any  #: ``(B, objects)`` int64: where each object's animation began (:meth:`MazeRules.animation_start`)
     damage_count: Any  #: ``(B,)`` int64: Doom's red flash counter (:func:`mjmaze.rules.flash`)
     bonus_count: Any  #: ``(B,)`` int64: Doom's gold flash counter
 
@@ -187,10 +192,29 @@ class MazeRules(abc.ABC):
     def episode_metrics(self, state: dict) -> dict:
         """The scenario's metric fields, each a ``(B,)`` array."""
 
+    def animation_start(self, xp, keys):
+        """``(B, objects)`` int64: the tic of ViZDoom's episode clock (:data:`FIRST_OBSERVATION_TIC`
+        at the first observation) at which each object's sprite animation began.
+
+        The released maps place their things, and Doom starts a map thing's
+        first frame with a random 1..its tics left (``P_SpawnMapThing``), so
+        two armours blink out of step, and an armour's blink against the
+        agent's 4-tic steps differs from maze to maze: measured in ViZDoom on
+        the released Labyrinth and K-item mazes (docs/look.md, "Items"). A
+        scenario whose script spawns its things overrides this (Two-colour).
+        """
+        device = rules.device(keys)
+        first_tics = rules.constant(xp, _first_frame_tics(tuple(self.objects)), xp.int64, device)
+        index = xp.arange(len(self.objects), dtype=xp.int64, device=device)
+        left = 1 + xp.astype(rules.uniform(xp, keys[:, None], rules.DRAW_ANIMATION, index[None, :]) * first_tics, xp.int64)
+        return left - first_tics  # the first frame then ends at tic ``left``
+
     def start_state(self, xp, config: dict, keys) -> dict:
-        """:meth:`start` plus the step count and the keys: what both backends call at an episode's start."""
+        """:meth:`start` plus the step count, the keys and the animations' start: what both backends call
+        at an episode's start."""
         state = self.start(xp, config, keys)
         state["key"] = keys
+        state["animation_start"] = self.animation_start(xp, keys)
         state["steps"] = xp.zeros(keys.shape, dtype=xp.int64, device=rules.device(keys))
         state["episode_return"] = xp.zeros(keys.shape, dtype=xp.float64, device=rules.device(keys))
         # Doom's flash counters (mjmaze.rules.flash); a scenario's rules set them.
@@ -225,6 +249,13 @@ class MazeRules(abc.ABC):
         """Names and Python types of an env's ``info`` fields (:func:`episode_info`), known before any episode."""
         fields = episode_info(self.new_episode_metrics(), 0.0, 0.0, 0.0, 0, 0.0, 0)
         return {key: type(value) for key, value in fields.items()}
+
+
+@functools.lru_cache(maxsize=None)
+def _first_frame_tics(objects: tuple) -> tuple[int, ...]:
+    """Tics of each object's first animation frame (1 without a sprite): one lasting tuple per
+    scenario, as :func:`mjmaze.rules.constant` wants."""
+    return tuple(obj.sprite.frames[0][1] if obj.sprite is not None else 1 for obj in objects)
 
 
 def episode_info(metrics: dict, x, y, yaw, step, episode_return, config_index) -> dict:

@@ -117,8 +117,10 @@ class SpriteView:
         geoms = mjcf.sprite_geoms(model, objects)
         #: ``(n,)`` int64 numpy: the geoms this view turns and pictures.
         self.geom_ids = geoms
-        by_name = {obj.name: obj for obj in objects}
-        of_geom = [by_name[model.geom(int(g)).name].sprite for g in geoms]
+        index_of = {obj.name: k for k, obj in enumerate(objects)}
+        #: ``(n,)`` int64 numpy: each geom's object (its index in ``objects``).
+        self.object_index = np.array([index_of[model.geom(int(g)).name] for g in geoms], dtype=np.int64)
+        of_geom = [objects[k].sprite for k in self.object_index]
         kinds = list(dict.fromkeys(of_geom))
         # Every kind's animation repeats within the least common multiple of their cycles.
         self._cycle = math.lcm(*(sum(t for _, t, _ in kind.frames) for kind in kinds)) if kinds else 1
@@ -142,10 +144,10 @@ class SpriteView:
     def __len__(self) -> int:
         return len(self.geom_ids)
 
-    def __call__(self, tics, eye_xy, yaw, sprite_xy):
-        """``(geom_matid (B, n), geom_quat (B, 4))`` of the sprite geoms in worlds at level tic ``tics``
-        ``(B,)`` int, the camera at ``eye_xy`` ``(B, 2)`` heading ``yaw`` ``(B,)``, the geoms at
-        ``sprite_xy`` ``(B, n, 2)``."""
+    def __call__(self, ages, eye_xy, yaw, sprite_xy):
+        """``(geom_matid (B, n), geom_quat (B, 4))`` of the sprite geoms in worlds where each geom's
+        animation began ``ages`` ``(B, n)`` int tics ago, the camera at ``eye_xy`` ``(B, 2)`` heading
+        ``yaw`` ``(B,)``, the geoms at ``sprite_xy`` ``(B, n, 2)``."""
         xp = self._xp
         half = yaw / 2
         zero = xp.zeros_like(half)
@@ -153,7 +155,7 @@ class SpriteView:
         offset = sprite_xy - eye_xy[:, None, :]
         depth = offset[..., 0] * xp.cos(yaw)[:, None] + offset[..., 1] * xp.sin(yaw)[:, None]
         depth_bin = xp.searchsorted(self._bin_edges, xp.astype(depth, self._bin_edges.dtype))
-        index = self._first + (xp.astype(tics, xp.int64)[:, None] % self._cycle) * self._bins + depth_bin
+        index = self._first + (xp.astype(ages, xp.int64) % self._cycle) * self._bins + depth_bin
         return xp.reshape(xp.take(self._materials, xp.reshape(index, (-1,)), axis=0), index.shape), quat
 
 

@@ -30,7 +30,7 @@ PICKUP_RADIUS = 36 / 128
 _MASK32 = 0xFFFFFFFF
 # What a draw is for: the first counter of every uniform(), so draws for
 # different purposes never share a hash.
-DRAW_CONFIG, DRAW_YAW, DRAW_COLOUR, DRAW_ITEM = 1, 2, 3, 4
+DRAW_CONFIG, DRAW_YAW, DRAW_COLOUR, DRAW_ITEM, DRAW_ANIMATION = 1, 2, 3, 4, 5
 
 
 def namespace(*arrays: Array):

@@ -170,6 +170,8 @@ class MazeBatchEnv(batch.BatchEnv):
         self._object_z = torch.tensor([obj.z for obj in task.objects], dtype=torch.float32, device=dev)
         self._sprites = look.SpriteView(self.xp, dev, mjm, task.objects, width) if task.visual_style == "textured" else None
         self._sprite_ids = torch.as_tensor(self._sprites.geom_ids if self._sprites else [], dtype=torch.long, device=dev)
+        self._sprite_objects = torch.as_tensor(self._sprites.object_index if self._sprites else [], dtype=torch.long,
+                                               device=dev)
         colliding = [k for k, obj in enumerate(task.objects) if obj.collides]
         self._colliding = torch.tensor(colliding, dtype=torch.long, device=dev)
         self._collision_ids = torch.tensor(
@@ -372,8 +374,9 @@ class MazeBatchEnv(batch.BatchEnv):
             eye_dz, pistol_dx, pistol_dy = look.view_bob(self.xp, self._bob, self.state["steps"] * core.TICS_PER_STEP)
             self._cam_pos[:, self._camera, 2] = (mjcf.EYE_HEIGHT + eye_dz).float()
         if len(self._sprite_ids):  # Doom's sprites: facing the camera, at their animation frame and depth
-            tics = look.EPISODE_START_TIC + self.state["steps"] * core.TICS_PER_STEP
-            materials, quat = self._sprites(tics, self._qpos[:, 0:2], self._qpos[:, 2], self._geom_pos[:, self._sprite_ids, 0:2])
+            clock = core.FIRST_OBSERVATION_TIC + self.state["steps"] * core.TICS_PER_STEP
+            ages = clock[:, None] - self.state["animation_start"][:, self._sprite_objects]
+            materials, quat = self._sprites(ages, self._qpos[:, 0:2], self._qpos[:, 2], self._geom_pos[:, self._sprite_ids, 0:2])
             self._geom_matid[:, self._sprite_ids] = materials.int()
             self._geom_quat[:, self._sprite_ids] = quat[:, None, :].float()
         mjw.kinematics(m, d)  # positions lag a step behind mjw.step's integration

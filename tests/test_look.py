@@ -11,8 +11,8 @@ import pytest
 
 import mjmaze
 
-from mjmaze import look, mjcf, palette, render, sprites, viz
-from mjmaze.tasks import base, find_return, labyrinth, two_colour
+from mjmaze import core, look, mjcf, palette, render, sprites, viz
+from mjmaze.tasks import base, find_return, k_item, labyrinth, two_colour
 
 from conftest import place
 
@@ -222,14 +222,15 @@ def test_a_sprite_faces_the_camera_from_every_side(heading):
 
 
 def test_the_armour_blinks_as_dooms_a_sector_lit_picture_then_a_fullbright_one():
-    # ZDoom's GreenArmor: ARM1 A for 6 tics, then B "bright" for 7; the level's
-    # clock starts at tic 10 and an agent step is 4 tics, so steps 0..12 show
-    # every tic of the cycle once.
+    # ZDoom's GreenArmor: ARM1 A for 6 tics, then B "bright" for 7; ViZDoom's
+    # episode clock reads tic 1 at the first observation and an agent step is 4
+    # tics, so steps 0..12 show every tic of the cycle once (this item's blink
+    # starts at tic 0, as the Two-colour script's first items).
     env = stone_room_with(sprites.GREEN_ARMOUR)
     env.physics.place_objects(env.physics.object_ids(["item_0"])[0], np.array([[1.0, 0.3]]))
     brightness = np.array([object_colour_at_step(env, step).sum() for step in range(13)])
     env.task.close()
-    tics = (look.EPISODE_START_TIC + 4 * np.arange(13)) % 13
+    tics = (core.FIRST_OBSERVATION_TIC + 4 * np.arange(13)) % 13
     lit, bright = brightness[tics < 6], brightness[tics >= 6]
     assert np.ptp(lit) < 0.02 * lit.mean() and np.ptp(bright) < 0.02 * bright.mean()  # one picture each
     assert bright.mean() > 1.3 * lit.mean()
@@ -241,6 +242,35 @@ def test_the_blue_armour_blinks_six_tics_each_way():
     # armour, tic by tic: aaBBBBBBaaaaaaBBBBBB...
     frames = sprites.frame_of_tic(sprites.BLUE_ARMOUR, 48)
     assert np.array_equal(frames[:12], [0] * 6 + [1] * 6) and np.array_equal(frames[12:24], frames[:12])
+
+
+def test_two_colours_red_item_is_bright_at_one_observation_in_three_as_in_vizdoom():
+    # The red ("blue") armour blinks 6 + 6 tics from its spawn; the script spawns
+    # it at tic 0 (or 60, 120, ...) and ViZDoom's observations fall on tics 1, 5,
+    # 9, ...: the sector-lit picture, the sector-lit one, then the fullbright one
+    # (measured on the released Two-colour 5 mazes: bright at 34% of observations).
+    env = stone_room_with(sprites.BLUE_ARMOUR)
+    env.physics.place_objects(env.physics.object_ids(["item_0"])[0], np.array([[1.0, 0.3]]))
+    brightness = np.array([object_colour_at_step(env, step).sum() for step in range(12)])
+    env.task.close()
+    bright = brightness > brightness.mean()
+    assert np.flatnonzero(bright).tolist() == [2, 5, 8, 11]
+
+
+def test_an_item_spawned_in_play_blinks_from_its_spawn_and_map_things_out_of_step():
+    # Two-colour's script spawns item 20 + j at tic 30 (j + 1): its animation
+    # starts then, whole. The released maps' things (K-item's items, Labyrinth's
+    # exit) start with a random 1..6 tics of their first frame left (Doom's
+    # P_SpawnMapThing), so K-item's two armours blink out of step in some mazes.
+    task = base.task_class(two_colour.TwoColour)(complexity=0, random=0)
+    start = task.animation_start(np, np.zeros(1, dtype=np.int64))[0]
+    assert start[:21].tolist() == [0] * 21 and start[21:24].tolist() == [30, 60, 90]
+    kitem = base.task_class(k_item.KItem)(num_items=4, random=0)
+    starts = kitem.animation_start(np, np.arange(200, dtype=np.int64))  # green, blue armour, medikit, soulsphere
+    for armour in (0, 1):
+        assert sorted(set(starts[:, armour].tolist())) == [-5, -4, -3, -2, -1, 0]
+    assert (starts[:, 0] != starts[:, 1]).mean() > 0.7
+    assert (starts[:, 2] == 0).all()  # one frame: nothing to be out of step with
 
 
 def object_colour_at_step(env, step):

@@ -123,15 +123,15 @@ def write_wad(path: pathlib.Path, text: str, behavior: bytes | None = None) -> N
 
 
 def area_resize(frame: np.ndarray, size: tuple[int, int] = SIZE) -> np.ndarray:
-    """Mean over each output pixel's footprint (cv2.INTER_AREA, as the released env resizes)."""
-    h, w = frame.shape[:2]
-    rows = np.minimum((np.arange(h) * size[1]) // h, size[1] - 1)
-    cols = np.minimum((np.arange(w) * size[0]) // w, size[0] - 1)
-    out = np.zeros((size[1], size[0]) + frame.shape[2:])
-    weight = np.zeros((size[1], size[0]))
-    np.add.at(out, (rows[:, None], cols[None, :]), frame.astype(np.float64))
-    np.add.at(weight, (rows[:, None], cols[None, :]), 1.0)
-    return out / weight.reshape(weight.shape + (1,) * (frame.ndim - 2))
+    """``frame`` resized as the released env resizes it (``cv2.INTER_AREA``: each output pixel the
+    mean over its footprint, source pixels split by their overlap), as float64.
+
+    cv2 rather than a hand-made binning: assigning each source pixel wholly to one output pixel
+    weights pixels unevenly at this 2.86x2.81 ratio and misstated a small item's contrast by 10-25%.
+    """
+    import cv2  # the bench extra, as ViZDoom
+
+    return cv2.resize(np.asarray(frame, dtype=np.float64), size, interpolation=cv2.INTER_AREA)
 
 
 def released_game(wad: pathlib.Path, weapon: bool = True, variables=(), buttons=None):

@@ -205,9 +205,10 @@ class MazeTask(core.MazeRules, base.Task):
     def _face_sprites(self) -> None:
         """Turns the sprites to the camera, at their animation frame and depth (:class:`mjmaze.look.SpriteView`)."""
         if self._sprites is not None and len(self._sprites):
-            tics = np.array([look.EPISODE_START_TIC + self.steps * TICS_PER_STEP])
+            clock = core.FIRST_OBSERVATION_TIC + self.steps * TICS_PER_STEP
+            ages = clock - self.state["animation_start"][self.row, self._sprites.object_index]
             ids, model = self._sprites.geom_ids, self._model
-            materials, quat = self._sprites(tics, self._qpos[None, 0:2], self._qpos[2:3], model.geom_pos[None, ids, 0:2])
+            materials, quat = self._sprites(ages[None], self._qpos[None, 0:2], self._qpos[2:3], model.geom_pos[None, ids, 0:2])
             model.geom_matid[ids] = materials[0]
             model.geom_quat[ids] = quat
 

@@ -159,6 +159,9 @@ TOTEM_PARKED_XY = (-4096 * mjcf.MAP_UNIT, 0.0)
 ITEMS = tuple(mjcf.sprite_thing(f"item_{k}", sprites.GREEN_ARMOUR if k % 2 == 0 else sprites.BLUE_ARMOUR)
               for k in range(POOL_SIZE))
 TOTEM_COLOURS = (tuple(RED), tuple(GREEN))  # by totem_green
+# Per object (the totem, then the pool): the tic its animation starts (TwoColour.animation_start).
+_ANIMATION_START = (0,) * (1 + 2 * START_ITEMS_PER_COLOUR) + tuple(
+    SPAWN_EVERY_TICS * j for j in range(1, POOL_SIZE - 2 * START_ITEMS_PER_COLOUR + 1))
 
 
 class TwoColour(core.MazeRules):
@@ -228,6 +231,14 @@ class TwoColour(core.MazeRules):
             state["object_shown"][:, 1 : 1 + first] = drawn
             state["items_spawned"] = state["items_spawned"] + first
         return state
+
+    def animation_start(self, xp, keys):
+        # The released script spawns the first 20 items at the episode's tic 0 and item 20 + j at
+        # tic 30 (j + 1); a thing spawned in play starts its first frame whole, so each item blinks
+        # from its spawn (measured in ViZDoom: docs/look.md, "Items"). The totem has no animation.
+        device = rules.device(keys)
+        return (xp.zeros((keys.shape[0], 1), dtype=xp.int64, device=device)
+                + rules.constant(xp, _ANIMATION_START, xp.int64, device)[None, :])
 
     def rules(self, xp, state, path):
         shown, health, totem_green = state["object_shown"], state["health"], state["totem_green"]
