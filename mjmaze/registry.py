@@ -26,7 +26,7 @@ class Scenario:
       name: what :func:`mjmaze.load` takes, e.g. ``"labyrinth"``.
       task: the scenario's class: a :class:`mjmaze.core.MazeRules` subclass (or, as before,
         a :class:`mjmaze.tasks.base.MazeTask` subclass).
-      gym_id: the gymnasium id, e.g. ``"mjmaze/Labyrinth-v11"``.
+      gym_id: the gymnasium id, e.g. ``"mjmaze/Labyrinth-v12"``.
       seed_code: an integer that enters every maze seed of the scenario. Fixed
         forever: changing it changes every published configuration. Distinct
         across scenarios.

@@ -10,7 +10,7 @@ Every process has one GL context for all its envs (faster than one per env: see
 
 Reached the standard way::
 
-    envs = gymnasium.make_vec("mjmaze/Labyrinth-v11", num_envs=16,
+    envs = gymnasium.make_vec("mjmaze/Labyrinth-v12", num_envs=16,
                               vectorization_mode="vector_entry_point", size=9)
 
 Autoreset follows gymnasium 1.x: ``autoreset_mode="next_step"`` (the default,

@@ -25,7 +25,7 @@ def no_leaked_segments():
 
 
 def test_make_vec_returns_the_shared_memory_vector_env():
-    envs = gymnasium.make_vec("mjmaze/Labyrinth-v11", num_envs=4, vectorization_mode="vector_entry_point", size=5)
+    envs = gymnasium.make_vec("mjmaze/Labyrinth-v12", num_envs=4, vectorization_mode="vector_entry_point", size=5)
     assert isinstance(envs, MazeVectorEnv)
     assert envs.observation_space.shape == (4, 64, 112, 3)
     assert envs.action_space == gymnasium.spaces.MultiDiscrete([5] * 4)

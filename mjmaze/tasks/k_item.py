@@ -22,6 +22,11 @@ The collection order is item kind 1, then 2, ... by the released files' colour
 codes: green, red, blue, cyan, magenta, yellow, then two greys, which also
 differ in shape (:data:`KINDS`).
 Version History
+    * v11 (2026-11-27): the items (map things) blink as ViZDoom's observations show them:
+      each map thing's first frame starts with a random 1..its tics left, as
+      Doom's ``P_SpawnMapThing`` does, on ViZDoom's episode clock (tic 1 at
+      the first observation), where the previous version ran every animation
+      on one clock from tic 10 (docs/look.md, "Items").
     * v10 (2026-11-27): the floor's flat laid as Doom lays flats: a 64-unit
       tile every half metre (v9 drew it twice as large), columns along x and
       rows along -y from the map's origin; the ceiling shows ``MFLR8_1`` the same
@@ -161,7 +166,7 @@ class KItem(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="k_item",
     task=KItem,
-    gym_id="mjmaze/KItem-v10",
+    gym_id="mjmaze/KItem-v11",
     seed_code=3,
     difficulty="num_items",
     difficulties=NUM_ITEMS,

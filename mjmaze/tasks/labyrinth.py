@@ -16,6 +16,11 @@ Arguments
 Metric
     ``success``: whether the exit was reached (success rate = mean over episodes).
 Version History
+    * v12 (2026-11-27): the exit (a map thing) blinks as ViZDoom's observations show them:
+      each map thing's first frame starts with a random 1..its tics left, as
+      Doom's ``P_SpawnMapThing`` does, on ViZDoom's episode clock (tic 1 at
+      the first observation), where the previous version ran every animation
+      on one clock from tic 10 (docs/look.md, "Items").
     * v11 (2026-11-27): the floor's flat laid as Doom lays flats: a 64-unit
       tile every half metre (v10 drew it twice as large), columns along x and
       rows along -y from the map's origin; the ceiling shows ``MFLR8_1`` the same
@@ -113,7 +118,7 @@ class Labyrinth(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="labyrinth",
     task=Labyrinth,
-    gym_id="mjmaze/Labyrinth-v11",
+    gym_id="mjmaze/Labyrinth-v12",
     seed_code=1,
     difficulty="size",
     difficulties=SIZES,

@@ -36,6 +36,11 @@ Arguments
 Metric
     ``duration``: tics survived (max 2100); also ``health`` and ``totem_green``.
 Version History
+    * v13 (2026-11-27): items blink as ViZDoom's observations show them: each
+      from its spawn (the first 20 at tic 0, then one every 30 tics) on
+      ViZDoom's episode clock (tic 1 at the first observation), where v12 ran
+      every animation on one clock from tic 10: the red item is bright at one
+      observation in three, not two (docs/look.md, "Items").
     * v12 (2026-11-27): the floor's flat laid as Doom lays flats: a 64-unit
       tile every half metre (v11 drew it twice as large), columns along x and
       rows along -y from the map's origin; the ceiling shows ``CEIL4_1`` the same
@@ -376,7 +381,7 @@ class TwoColour(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="two_colour",
     task=TwoColour,
-    gym_id="mjmaze/TwoColour-v12",
+    gym_id="mjmaze/TwoColour-v13",
     seed_code=4,
     difficulty="complexity",
     difficulties=COMPLEXITIES,
