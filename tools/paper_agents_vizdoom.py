@@ -6,6 +6,7 @@
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --along k_item_6        # ViZDoom's frames along mjmaze's path: memory or frame?
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --swap k_item_6 --sight vizdoom  # mjmaze's motion, ViZDoom's frames
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --picks two_colour_5      # right and wrong picks, both engines
+    python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --blink two_colour_5      # the items' blink at the observations
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --motion labyrinth_13     # each step from ViZDoom's state: where it lands
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --shift 1 --out F         # frames moved 1 px: the probe's scale
     python tools/paper_agents_vizdoom.py RELEASED_CHECKOUT --freedoom vizdoom --out F # ViZDoom's own Freedoom 0.13
@@ -49,7 +50,7 @@ import urllib.request
 import numpy as np
 import torch
 
-from mjmaze import files, mjcf, rules, suite
+from mjmaze import core, files, mjcf, rules, suite
 from mjmaze.train import paper_agents
 
 LIMITED_ACTIONS = ([True, False, False, False], [False, True, False, False], [False, False, True, False],
@@ -596,6 +597,97 @@ def picks(name: str, checkout: str, mazes: int = 32, wad: str | None = None) -> 
     return table
 
 
+# Things that blink between a sector-lit picture and a fullbright one, by ViZDoom's object name.
+_BLINKING = {"GreenArmor": "GREEN_ARMOUR", "BlueArmor": "BLUE_ARMOUR", "RedCard": "RED_KEYCARD",
+             "BlueCard": "BLUE_KEYCARD"}
+
+
+def blink(name: str, checkout: str, mazes: int = 8, steps: int = 300, wad: str | None = None) -> dict[str, dict]:
+    """How often each blinking item shows its fullbright picture at the observations, in both engines.
+
+    A uniformly random policy (forward-leaning, seeded) plays ``steps``
+    steps on each of the first ``mazes`` test mazes. ViZDoom: each sighted
+    armour or keycard 0.8-5 m ahead (15 pixels or more of the labels buffer)
+    is sorted into its sector-lit picture or its fullbright one by which one's
+    colours at that depth (``sprites.colormap_of_depth``) its drawn mean is
+    nearer. mjmaze: each sprite in view (its segmentation) by the animation
+    frame :class:`mjmaze.look.SpriteView` gives it. Returns, per engine and
+    Doom name: sightings and the share of them bright.
+    """
+    import math
+
+    import mjmaze
+    from mjmaze import sprites
+
+    info = paper_agents.get(name)
+    folder = pathlib.Path(checkout) / paper_agents.MAZES / info.maze_folder / "test"
+    kinds = {doom: getattr(sprites, attribute) for doom, attribute in _BLINKING.items()}
+    palette_rgb = sprites.palette_colours().astype(np.float64)
+
+    def pictures(sprite, depth):  # the mean colours of its sector-lit and fullbright pictures there
+        indices, opaque, _ = sprites.picture_indices(f"{sprite.name}A0")
+        lit = palette_rgb[sprites.colormaps()[int(sprites.colormap_of_depth(np.array(depth)))][indices[opaque]]]
+        rgb, mask, _ = sprites.picture(f"{sprite.name}B0")
+        return lit.mean(axis=0), rgb[mask].astype(np.float64).mean(axis=0)
+
+    counts = {"vizdoom": {}, "mjmaze": {}}
+    rng = np.random.default_rng(0)
+    policy_p = (0.15, 0.15, 0.4, 0.15, 0.15)
+    for index in range(mazes):
+        game = _game(folder / f"custom_scenario{index:03d}.cfg", seed=_maze_seed(0, index), objects=True, wad=wad,
+                     labels=True)
+        for _ in range(steps):
+            if game.is_episode_finished():
+                break
+            state = game.get_state()
+            player = next(o for o in state.objects if o.name == "DoomPlayer")
+            yaw = math.radians(player.angle)
+            for label in state.labels:
+                sprite = kinds.get(label.object_name)
+                drawn = state.labels_buffer == label.value
+                if sprite is None or drawn.sum() < 15:
+                    continue
+                depth = ((label.object_position_x - player.position_x) * math.cos(yaw)
+                         + (label.object_position_y - player.position_y) * math.sin(yaw)) * mjcf.MAP_UNIT
+                if not 0.8 <= depth <= 5.0:
+                    continue
+                colour = state.screen_buffer.transpose(1, 2, 0)[drawn].astype(np.float64).mean(axis=0)
+                lit, bright = pictures(sprite, depth)
+                seen = counts["vizdoom"].setdefault(label.object_name, [0, 0])
+                seen[0] += 1
+                seen[1] += int(np.abs(colour - bright).sum() < np.abs(colour - lit).sum())
+            game.make_action(LIMITED_ACTIONS[rng.choice(5, p=policy_p)], FRAME_SKIP)
+        game.close()
+    env = mjmaze.load(info.scenario, task_kwargs={**info.task_kwargs, "layouts": str(folder), "num_configs": mazes,
+                                                  "config_sampling": "cycle", "random": 0})
+    task, physics = env.task, env.physics
+    by_geom = {}  # sprite geom id -> (Doom name, its object's index)
+    for doom, sprite in kinds.items():
+        for k, obj in enumerate(task.objects):
+            if obj.sprite is sprite:
+                by_geom[int(physics.object_ids([obj.name])[1][0])] = (doom, k)
+    for _ in range(mazes):
+        timestep = env.reset()
+        for _ in range(steps):
+            if timestep.last():
+                break
+            ids, visible = np.unique(task.segmentation(physics), return_counts=True)
+            clock = core.FIRST_OBSERVATION_TIC + task.steps * core.TICS_PER_STEP
+            for geom, pixels in zip(ids.tolist(), visible.tolist()):
+                if geom in by_geom and pixels >= 2:  # 15 of 320x180's pixels are ~2 of 112x64's
+                    doom, k = by_geom[geom]
+                    age = clock - int(task.state["animation_start"][task.row, k])
+                    cycle = sum(tics for _, tics, _ in kinds[doom].frames)
+                    frame = int(sprites.frame_of_tic(kinds[doom], cycle)[age % cycle])
+                    seen = counts["mjmaze"].setdefault(doom, [0, 0])
+                    seen[0] += 1
+                    seen[1] += int(kinds[doom].frames[frame][2])
+            timestep = env.step(int(rng.choice(5, p=policy_p)))
+    task.close()
+    return {engine: {doom: {"sightings": n, "bright": b / n} for doom, (n, b) in rows.items()}
+            for engine, rows in counts.items()}
+
+
 def _reset_to(env, index: int) -> None:
     """Resets a ``layouts=`` env until it plays configuration (released maze) ``index``."""
     env.reset()
@@ -657,6 +749,9 @@ def main() -> None:
                              "released): how far a score moves for a change that is no engine's")
     parser.add_argument("--picks", metavar="SETTING", default=None,
                         help="instead: a Two-colour agent's right and wrong picks in both engines, by totem colour")
+    parser.add_argument("--blink", metavar="SETTING", default=None,
+                        help="instead: how often the setting's blinking items (armours, keycards) show their "
+                             "fullbright picture at the observations, in both engines (a random walk)")
     parser.add_argument("--agreement", metavar="SETTING", default=None,
                         help="instead: how often a Labyrinth or Two-colour agent acts alike on both engines' frames "
                              "at the same poses, and how far apart the engines' frames are there")
@@ -695,6 +790,14 @@ def main() -> None:
         if scenario == "two_colour":
             hidden = agreement(args.agreement, str(args.checkout), mazes=mazes, hide_items=True, wad=wad)[0]
             print(f"  with mjmaze's items hidden: {hidden:.1%}")
+        return
+    if args.blink:
+        table = blink(args.blink, str(args.checkout), mazes=mazes, wad=wad)
+        print(f"{args.blink}, a random walk of 300 steps on each of the first {mazes} test mazes: items seen "
+              "0.8-5 m ahead, the share of observations showing their fullbright picture")
+        for engine, rows in table.items():
+            print(f"  {engine}: " + ", ".join(f"{doom} {row['bright']:.0%} of {row['sightings']}"
+                                              for doom, row in sorted(rows.items())))
         return
     if args.swap:
         try:
