@@ -248,7 +248,7 @@ def test_two_colours_red_item_is_bright_at_one_observation_in_three_as_in_vizdoo
     # The red ("blue") armour blinks 6 + 6 tics from its spawn; the script spawns
     # it at tic 0 (or 60, 120, ...) and ViZDoom's observations fall on tics 1, 5,
     # 9, ...: the sector-lit picture, the sector-lit one, then the fullbright one
-    # (measured on the released Two-colour 5 mazes: bright at 34% of observations).
+    # (measured on the released Two-colour 5 mazes: bright at 35% of sightings).
     env = stone_room_with(sprites.BLUE_ARMOUR)
     env.physics.place_objects(env.physics.object_ids(["item_0"])[0], np.array([[1.0, 0.3]]))
     brightness = np.array([object_colour_at_step(env, step).sum() for step in range(12)])
