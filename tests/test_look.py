@@ -258,13 +258,13 @@ def test_two_colours_red_item_is_bright_at_one_observation_in_three_as_in_vizdoo
 
 
 def test_an_item_spawned_in_play_blinks_from_its_spawn_and_map_things_out_of_step():
-    # Two-colour's script spawns item 20 + j at tic 30 (j + 1): its animation
+    # Two-colour's script spawns item 21 + j at tic 30 (j + 1): its animation
     # starts then, whole. The released maps' things (K-item's items, Labyrinth's
     # exit) start with a random 1..6 tics of their first frame left (Doom's
     # P_SpawnMapThing), so K-item's two armours blink out of step in some mazes.
     task = base.task_class(two_colour.TwoColour)(complexity=0, random=0)
     start = task.animation_start(np, np.zeros(1, dtype=np.int64))[0]
-    assert start[:21].tolist() == [0] * 21 and start[21:24].tolist() == [30, 60, 90]
+    assert start[:22].tolist() == [0] * 22 and start[22:25].tolist() == [30, 60, 90]  # the totem, then the items
     kitem = base.task_class(k_item.KItem)(num_items=4, random=0)
     starts = kitem.animation_start(np, np.arange(200, dtype=np.int64))  # green, blue armour, medikit, soulsphere
     for armour in (0, 1):

@@ -164,34 +164,37 @@ def test_totem_colour_is_drawn_per_episode_and_shown():
     assert tuple(totem_rgba) == pytest.approx(two_colour.GREEN if colours[-1] else two_colour.RED)
 
 
-def test_twenty_items_start_and_one_more_every_thirty_tics():
+def test_eleven_green_and_ten_red_items_start_and_one_more_every_thirty_tics_red_first():
+    # As ViZDoom plays the released script: its 10 items of each colour, and its
+    # timer's first (green) at tic 0, are all on the floor at the first
+    # observation; the timer's next is red, at tic 30, then green at tic 60, ...
     env = load("two_colour", complexity=3)
     task = env.task
-    assert task.item_active.sum() == 20
-    assert task.item_green[:20].sum() == 10
+    assert task.item_active.sum() == 21
+    assert task.item_green[:21].sum() == 11
     counts = []
     for _ in range(30):
         env.step(TURN_LEFT)
         counts.append(task.items_spawned)
-    # Tic 4k after k steps: item 21 at tic 30 (step 8), item 22 at tic 60 (step 15), ...
-    assert counts[6] == 20 and counts[7] == 21 and counts[13] == 21 and counts[14] == 22
-    assert counts[-1] == 20 + (30 * 4) // 30
-    assert list(task.item_green[20:24]) == [True, False, True, False]  # colours alternate
+    # Tic 4k after k steps: item 22 at tic 30 (step 8), item 23 at tic 60 (step 15), ...
+    assert counts[6] == 21 and counts[7] == 22 and counts[13] == 22 and counts[14] == 23
+    assert counts[-1] == 21 + (30 * 4) // 30
+    assert list(task.item_green[21:25]) == [False, True, False, True]  # red first, colours alternate
 
 
 def test_no_item_cap_by_default_and_an_optional_cap_of_60():
     uncapped = load("two_colour", complexity=1)
     capped = load("two_colour", complexity=1, item_cap=60)
-    for _ in range(300):  # tic 1200: 20 + 40 items due; spinning in place
+    for _ in range(300):  # tic 1200: 21 + 40 items due; spinning in place
         for env in (uncapped, capped):
             env.task.health = 100  # keep the agent alive
             env.step(TURN_LEFT)
-    assert uncapped.task.items_spawned == 60
+    assert uncapped.task.items_spawned == 61
     for _ in range(100):
         for env in (uncapped, capped):
             env.task.health = 100
             env.step(TURN_LEFT)
-    assert uncapped.task.items_spawned == 20 + (400 * 4) // 30  # 73: no cap
+    assert uncapped.task.items_spawned == 21 + (400 * 4) // 30  # 74: no cap
     assert capped.task.items_spawned == 60
 
 
@@ -202,7 +205,7 @@ def test_pool_covers_a_full_episode():
         env.step(TURN_LEFT)
     timestep = env.step(TURN_LEFT)
     assert timestep.last() and timestep.discount == 1.0
-    assert env.task.items_spawned == two_colour.POOL_SIZE == 90
+    assert env.task.items_spawned == two_colour.POOL_SIZE == 91
     assert env.task.metrics()["duration"] == 2100
 
 

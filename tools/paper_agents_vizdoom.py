@@ -246,16 +246,20 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
     folder = pathlib.Path(checkout) / paper_agents.MAZES / info.maze_folder / "test"
     env = mjmaze.load(info.scenario, task_kwargs={**info.task_kwargs, "layouts": str(folder), "head_bob": False})
     task = env.task
-    same, same_shifted, gaps = [], [], []
+    same, same_shifted, gaps, by_totem = [], [], [], {}
     for index in range(mazes):
         centre = _maze_centre(folder, index)
         game = _game(folder / f"custom_scenario{index:03d}.cfg", seed=index, objects=two_colour, wad=wad)
-        path = []
+        path, starts = [], {}  # starts: each item's spawn tic (the script spawns every 30 tics)
         hidden, start = agent.initial_state(1), torch.ones(1, dtype=torch.bool)
         health, flashes = game.get_game_variable(vzd.GameVariable.HEALTH), [0, 0]  # damage, bonus counts
         while not game.is_episode_finished():
             x, y, angle = (game.get_game_variable(getattr(vzd.GameVariable, v)) for v in _POSE)
             things = _two_colour_things(game, centre) if two_colour else None
+            if two_colour:
+                tic = game.get_state().tic
+                for *_, object_id in things[0]:
+                    starts.setdefault(object_id, 30 * ((tic - 1) // 30))
             with torch.no_grad():
                 logits, _, hidden = agent.step(agent.features(torch.from_numpy(_frame(game)[None])), hidden, start)
             start[:] = False
@@ -278,9 +282,11 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
         _reset_to(env, index)
         hidden, start = agent.initial_state(1), torch.ones(1, dtype=torch.bool)
         shifted_hidden = agent.initial_state(1)
-        for x, y, yaw, action, things, flashes, doom, shifted in path:
+        totem = "none" if not two_colour or path[0][4][1] is None else ("green" if path[0][4][1] else "red")
+        for step, (x, y, yaw, action, things, flashes, doom, shifted) in enumerate(path):
             if two_colour:
-                _place_two_colour_things(task, env.physics, things, flashes, hide_items)
+                _place_two_colour_things(task, env.physics, things, flashes, hide_items, starts)
+            task.state["steps"][task.row] = step  # the things' animations at ViZDoom's tic of this pose
             env.physics.set_agent_pose(x, y, yaw)
             env.physics.forward()
             frame = np.ascontiguousarray(task.get_observation(env.physics)["pixels"])
@@ -291,9 +297,11 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
                                                                shifted_hidden, start)
             start[:] = False
             same.append(int(logits.argmax()) == action)
+            by_totem.setdefault(totem, []).append(same[-1])
             same_shifted.append(int(shifted_logits.argmax()) == action)
     task.close()
     gap = dict(zip(("pixel", "block", "column"), np.mean(gaps, axis=0).tolist()))
+    gap["by_totem"] = {totem: (float(np.mean(alike)), len(alike)) for totem, alike in by_totem.items()}
     return float(np.mean(same)), float(np.mean(same_shifted)), gap
 
 
@@ -701,12 +709,12 @@ def _metres(x: float, y: float, centre: np.ndarray) -> tuple[float, float]:
 
 
 def _two_colour_things(game, centre: np.ndarray) -> tuple[list, bool | None]:
-    """ViZDoom's Two-colour items ``[(x, y, green)]`` in mjmaze's metres, and whether the totem is green.
+    """ViZDoom's Two-colour items ``[(x, y, green, object id)]`` in mjmaze's metres, and whether the totem is green.
 
     ``None`` where the map has no totem (the script could not move a column onto the spot).
     """
     objects = game.get_state().objects
-    items = [(*_metres(o.position_x, o.position_y, centre), o.name == "GreenArmor")
+    items = [(*_metres(o.position_x, o.position_y, centre), o.name == "GreenArmor", o.id)
              for o in objects if o.name in ("GreenArmor", "BlueArmor")]
     # The script moves one of two columns parked 4,000 units away onto the totem's spot
     # (neither, where the agent stands on it).
@@ -715,8 +723,9 @@ def _two_colour_things(game, centre: np.ndarray) -> tuple[list, bool | None]:
 
 
 def _place_two_colour_things(task, physics, things: tuple[list, bool | None], flashes: tuple[int, int],
-                             hide: bool) -> None:
-    """Sets mjmaze's Two-colour episode to ViZDoom's things and flash counters (items of a colour fill its slots in turn)."""
+                             hide: bool, starts: dict | None = None) -> None:
+    """Sets mjmaze's Two-colour episode to ViZDoom's things and flash counters (items of a colour fill its slots in
+    turn); ``starts``: each ViZDoom item's (by object id) animation start, its spawn tic."""
     from mjmaze.tasks import two_colour
 
     items, totem_green = things
@@ -726,11 +735,13 @@ def _place_two_colour_things(task, physics, things: tuple[list, bool | None], fl
         state["totem_green"][row] = totem_green
         state["object_rgba"][row, 0] = two_colour.TOTEM_COLOURS[int(totem_green)]
     shown, xy, used = np.zeros(two_colour.POOL_SIZE, dtype=bool), np.zeros((two_colour.POOL_SIZE, 2)), [0, 0]
-    for x, y, green in items:
+    for x, y, green, object_id in items:
         slot = 2 * used[0] if green else 2 * used[1] + 1  # green items are the even slots
         used[0 if green else 1] += 1
         if slot < two_colour.POOL_SIZE:
             shown[slot], xy[slot] = not hide, (x, y)
+            if starts is not None:
+                state["animation_start"][row, 1 + slot] = starts[object_id]
     state["object_xy"][row, 1:], state["object_shown"][row, 1:] = xy, shown
     state["damage_count"][row], state["bonus_count"][row] = flashes
     task._sync_objects(physics, everything=True)
@@ -788,6 +799,8 @@ def main() -> None:
         print(f"  the frames' mean grey difference at those poses: {gap['pixel']:.2f} per pixel, {gap['block']:.2f} "
               f"in 8x8 blocks, {gap['column']:.2f} per column")
         if scenario == "two_colour":
+            print("  by the totem's colour: " + ", ".join(f"{totem} {share:.1%} of {poses} poses"
+                                                      for totem, (share, poses) in sorted(gap["by_totem"].items())))
             hidden = agreement(args.agreement, str(args.checkout), mazes=mazes, hide_items=True, wad=wad)[0]
             print(f"  with mjmaze's items hidden: {hidden:.1%}")
         return

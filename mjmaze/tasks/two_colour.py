@@ -5,11 +5,12 @@ Action Space
 Observation
     ``pixels``: uint8 RGB ``(64, 112, 3)``, no weapon (as every scenario).
 Rules
-    A tall totem at the maze centre is red or green, 50/50 per episode. 10
+    A tall totem at the maze centre is red or green, 50/50 per episode. 11
     green and 10 red items start at random positions, uniform over the floor
     where an armour fits (as the released script spawns them) and out of the
-    agent's reach; one more appears every 30 tics, colours alternating, with no
-    cap (as released; at most 90 in an episode, a fixed pool of 90 geoms).
+    agent's reach: its 10 of each colour and its timer's first item, green, at
+    tic 0; the timer adds one every 30 tics, red first, colours alternating,
+    with no cap (as released; at most 91 in an episode, a fixed pool of 91 geoms).
     Health (cap 100) decays as the released maze's floor takes it, Doom's hefty
     lava: 8 every 32 tics, the first hit already taken at the first observation
     (health 92), the next 23 tics in, as ViZDoom plays it. An item of the
@@ -36,11 +37,14 @@ Arguments
 Metric
     ``duration``: tics survived (max 2100); also ``health`` and ``totem_green``.
 Version History
-    * v13 (2026-11-27): items blink as ViZDoom's observations show them: each
-      from its spawn (the first 20 at tic 0, then one every 30 tics) on
-      ViZDoom's episode clock (tic 1 at the first observation), where v12 ran
-      every animation on one clock from tic 10: the red item is bright at one
-      observation in three, not two (docs/look.md, "Items").
+    * v13 (2026-11-27): 11 green and 10 red items at the start, the next
+      red at tic 30, as ViZDoom plays the released script (its timer's first
+      item, green, comes at tic 0; v12 started with 10 and 10 and spawned
+      green first at tic 30). Items blink as ViZDoom's observations show
+      them: each from its spawn on ViZDoom's episode clock (tic 1 at the
+      first observation), where v12 ran every animation on one clock from
+      tic 10: the red item is bright at one observation in three, not two
+      (docs/look.md, "Items"; docs/scenarios.md).
     * v12 (2026-11-27): the floor's flat laid as Doom lays flats: a 64-unit
       tile every half metre (v11 drew it twice as large), columns along x and
       rows along -y from the map's origin; the ceiling shows ``CEIL4_1`` the same
@@ -110,7 +114,11 @@ GRID_SIZE = 5
 CELL_SIZE = 2.0
 START_ITEMS_PER_COLOUR = 10
 SPAWN_EVERY_TICS = 30
-POOL_SIZE = 2 * START_ITEMS_PER_COLOUR + (core.EPISODE_STEPS * core.TICS_PER_STEP) // SPAWN_EVERY_TICS  # 90
+# The released script's 10 of each colour, then its timer's items every 30 tics from tic 0,
+# green first: 11 green and 10 red at the first observation, the next (red) at tic 30
+# (measured in ViZDoom: docs/scenarios.md, "Two-colour's items").
+START_ITEMS = 2 * START_ITEMS_PER_COLOUR + 1
+POOL_SIZE = START_ITEMS + (core.EPISODE_STEPS * core.TICS_PER_STEP) // SPAWN_EVERY_TICS  # 91
 MAX_HEALTH = 100
 ITEM_HEALTH = 25
 # The released script hands over the armour first, then takes 25 with
@@ -165,8 +173,7 @@ ITEMS = tuple(mjcf.sprite_thing(f"item_{k}", sprites.GREEN_ARMOUR if k % 2 == 0 
               for k in range(POOL_SIZE))
 TOTEM_COLOURS = (tuple(RED), tuple(GREEN))  # by totem_green
 # Per object (the totem, then the pool): the tic its animation starts (TwoColour.animation_start).
-_ANIMATION_START = (0,) * (1 + 2 * START_ITEMS_PER_COLOUR) + tuple(
-    SPAWN_EVERY_TICS * j for j in range(1, POOL_SIZE - 2 * START_ITEMS_PER_COLOUR + 1))
+_ANIMATION_START = (0,) * (1 + START_ITEMS) + tuple(SPAWN_EVERY_TICS * j for j in range(1, POOL_SIZE - START_ITEMS + 1))
 
 
 class TwoColour(core.MazeRules):
@@ -175,7 +182,7 @@ class TwoColour(core.MazeRules):
     scenario = "two_colour"
     room = palette.SLIME_ROOM
     objects = (TOTEM, *ITEMS)
-    # 20 items, each tried at 32 points against every wall box: ~20x a step's spawn.
+    # 21 items, each tried at 32 points against every wall box: ~21x a step's spawn.
     costly_start = True
 
     def __init__(
@@ -228,7 +235,7 @@ class TwoColour(core.MazeRules):
             "health": xp.full(batch, START_HEALTH, dtype=xp.int64, device=device),
             "items_spawned": xp.zeros(batch, dtype=xp.int64, device=device),
         }
-        first = min(2 * START_ITEMS_PER_COLOUR, self._item_cap)
+        first = min(START_ITEMS, self._item_cap)
         if first:
             items = xp.broadcast_to(xp.arange(first, dtype=xp.int64, device=device)[None, :], (batch, first))
             xy, drawn = self._free_positions(xp, state, keys, items, spawn_xy)
@@ -238,7 +245,7 @@ class TwoColour(core.MazeRules):
         return state
 
     def animation_start(self, xp, keys):
-        # The released script spawns the first 20 items at the episode's tic 0 and item 20 + j at
+        # The released script spawns the first 21 items at the episode's tic 0 and item 21 + j at
         # tic 30 (j + 1); a thing spawned in play starts its first frame whole, so each item blinks
         # from its spawn (measured in ViZDoom: docs/look.md, "Items"). The totem has no animation.
         device = rules.device(keys)
@@ -288,7 +295,7 @@ class TwoColour(core.MazeRules):
         state["health"] = health
         shown = xp.concat([shown[:, :1], shown[:, 1:] & ~picked], axis=1)
         # One item every 30 tics (never more than one per 4-tic step after the start).
-        due = rules.at_most(xp, 2 * START_ITEMS_PER_COLOUR + state["steps"] * core.TICS_PER_STEP // SPAWN_EVERY_TICS, self._item_cap)
+        due = rules.at_most(xp, START_ITEMS + state["steps"] * core.TICS_PER_STEP // SPAWN_EVERY_TICS, self._item_cap)
         spawn = ~dead & (state["items_spawned"] < due)
         # On numpy most steps spawn nothing: skip the draws then. On torch, draw
         # for every env and keep the spawns (asking whether any is due would wait for the GPU).
