@@ -105,7 +105,7 @@ def test_info_carries_metrics_and_pose_on_every_step(task_name):
         ("k_item", {"num_items": 8, "size": 2}, "needs 9 distinct cells"),
         ("two_colour", {"complexity": 11}, "(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10)"),
         ("two_colour", {"size": 5}, "complexity"),  # Two-colour has no size: the error lists what it has
-        ("two_colour", {"item_cap": 91}, "item_cap"),
+        ("two_colour", {"item_cap": 92}, "item_cap"),
     ],
 )
 def test_bad_input_raises_a_value_error_listing_valid_choices(name, kwargs, expected):
