@@ -202,12 +202,19 @@ def mjmaze_view(env, spawn: tuple[float, float, int], objects: list[str]) -> tup
     mask = np.isin(task.segmentation(physics), geoms).astype(np.float64)
     rows, cols, _ = look.pistol_pixels(*SIZE)
     mask[rows, cols] = 0.0  # what the pistol hides
+    return mjmaze_steps(env).mean(axis=0).round().astype(np.uint8), mask
+
+
+def mjmaze_steps(env) -> np.ndarray:
+    """mjmaze's frames (float64) from where the agent stands at steps 0 .. :data:`MJMAZE_ANIMATION_STEPS` - 1
+    of the episode: its things at each step's animation frame."""
+    task, physics = env.task, env.physics
     frames = []
     for step in range(MJMAZE_ANIMATION_STEPS):
         task.state["steps"][task.row] = step
         frames.append(task.get_observation(physics)["pixels"].astype(np.float64))
     task.state["steps"][task.row] = 0
-    return np.mean(frames, axis=0).round().astype(np.uint8), mask
+    return np.array(frames)
 
 
 def corridor_poses(config: configs.MazeConfig, cell: tuple[int, int]) -> dict[int, tuple[int, int, int]]:
@@ -527,19 +534,9 @@ def item_contrast() -> None:
     env = empty_arena("slime", pistol=False)
     config, physics = env.task.config, env.physics
     empty_doom, _ = doom_tics(textmap(config, (0.0, 0.0, 0), [], SLIME), weapon=False)
-    task = env.task
-
-    def ours() -> np.ndarray:
-        frames = []
-        for step in range(MJMAZE_ANIMATION_STEPS):
-            task.state["steps"][task.row] = step
-            frames.append(task.get_observation(physics)["pixels"].astype(np.float64))
-        task.state["steps"][task.row] = 0
-        return np.array(frames)
-
     physics.set_agent_pose(0.0, 0.0, 0.0)
     physics.forward()
-    empty_ours = ours()
+    empty_ours = mjmaze_steps(env)
     print("Two-colour items straight ahead, contrast mass summed over 0.8-4 m (Doom | mjmaze, mjmaze / Doom)")
     for label, doom_type, item in (("green item (green armour)", GREEN_ARMOUR, two_colour.ITEMS[0]),
                                    ("red item (Freedoom's blue armour)", BLUE_ARMOUR, two_colour.ITEMS[1])):
@@ -550,14 +547,14 @@ def item_contrast() -> None:
             frames, _ = doom_tics(textmap(config, (0.0, 0.0, 0), [Thing(d * UNITS, 0.0, doom_type)], SLIME),
                                   weapon=False)
             physics.place_objects(ids[0], np.array([[d, 0.0]]))
-            for engine, (seen, empty) in enumerate(((frames, empty_doom), (ours(), empty_ours))):
+            for engine, (seen, empty) in enumerate(((frames, empty_doom), (mjmaze_steps(env), empty_ours))):
                 mass = np.abs(seen.astype(np.float64) - empty.astype(np.float64)).sum(axis=(1, 2, 3)) / 255
                 bright = mass > (mass.min() + mass.max()) / 2
                 total[engine] += mass[~bright].mean(), mass[bright].mean()
         physics.show_objects(ids[1], False)
         print(f"  {label}: sector-lit {total[0, 0]:.0f} | {total[1, 0]:.0f}, x{total[1, 0] / total[0, 0]:.2f}; "
               f"fullbright {total[0, 1]:.0f} | {total[1, 1]:.0f}, x{total[1, 1] / total[0, 1]:.2f}")
-    task.close()
+    env.task.close()
 
 
 def flashes() -> None:

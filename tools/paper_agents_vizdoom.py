@@ -50,7 +50,7 @@ import urllib.request
 import numpy as np
 import torch
 
-from mjmaze import core, files, mjcf, rules, suite
+from mjmaze import core, files, mjcf, rules, sprites, suite
 from mjmaze.train import paper_agents
 
 LIMITED_ACTIONS = ([True, False, False, False], [False, True, False, False], [False, False, True, False],
@@ -240,6 +240,8 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
 
     import mjmaze
 
+    from mjmaze.tasks.two_colour import SPAWN_EVERY_TICS as every
+
     info = paper_agents.get(name)
     two_colour = info.scenario == "two_colour"
     _, agent, _ = paper_agents.load(name, paper_dir=checkout)
@@ -250,7 +252,7 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
     for index in range(mazes):
         centre = _maze_centre(folder, index)
         game = _game(folder / f"custom_scenario{index:03d}.cfg", seed=index, objects=two_colour, wad=wad)
-        path, starts = [], {}  # starts: each item's spawn tic (the script spawns every 30 tics)
+        path, starts = [], {}  # starts: each item's spawn tic (the script's timer's, seen within a step)
         hidden, start = agent.initial_state(1), torch.ones(1, dtype=torch.bool)
         health, flashes = game.get_game_variable(vzd.GameVariable.HEALTH), [0, 0]  # damage, bonus counts
         while not game.is_episode_finished():
@@ -259,7 +261,7 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
             if two_colour:
                 tic = game.get_state().tic
                 for *_, object_id in things[0]:
-                    starts.setdefault(object_id, 30 * ((tic - 1) // 30))
+                    starts.setdefault(object_id, every * ((tic - 1) // every))
             with torch.no_grad():
                 logits, _, hidden = agent.step(agent.features(torch.from_numpy(_frame(game)[None])), hidden, start)
             start[:] = False
@@ -606,8 +608,8 @@ def picks(name: str, checkout: str, mazes: int = 32, wad: str | None = None) -> 
 
 
 # Things that blink between a sector-lit picture and a fullbright one, by ViZDoom's object name.
-_BLINKING = {"GreenArmor": "GREEN_ARMOUR", "BlueArmor": "BLUE_ARMOUR", "RedCard": "RED_KEYCARD",
-             "BlueCard": "BLUE_KEYCARD"}
+_BLINKING = {"GreenArmor": sprites.GREEN_ARMOUR, "BlueArmor": sprites.BLUE_ARMOUR, "RedCard": sprites.RED_KEYCARD,
+             "BlueCard": sprites.BLUE_KEYCARD}
 
 
 def blink(name: str, checkout: str, mazes: int = 8, steps: int = 300, wad: str | None = None) -> dict[str, dict]:
@@ -625,11 +627,10 @@ def blink(name: str, checkout: str, mazes: int = 8, steps: int = 300, wad: str |
     import math
 
     import mjmaze
-    from mjmaze import sprites
 
     info = paper_agents.get(name)
     folder = pathlib.Path(checkout) / paper_agents.MAZES / info.maze_folder / "test"
-    kinds = {doom: getattr(sprites, attribute) for doom, attribute in _BLINKING.items()}
+    kinds = _BLINKING
     palette_rgb = sprites.palette_colours().astype(np.float64)
 
     def pictures(sprite, depth):  # the mean colours of its sector-lit and fullbright pictures there
