@@ -15,7 +15,7 @@ from collections.abc import Sequence
 import mujoco
 import numpy as np
 
-from mjmaze import mjcf, palette, rules, sprites, walls
+from mjmaze import core, mjcf, palette, rules, sprites, walls
 
 # Head-bob: Doom's P_CalcHeight and P_BobWeapon. Walking swings the eye by half
 # the "bob", min(v^2 / 4, 16) map units with v the speed after the tic's thrust
@@ -176,16 +176,18 @@ def flash(xp, frames, damage_count, bonus_count):
 
 
 # Doom's light (palette.DepthLight), applied to a frame GL or MuJoCo Warp drew
-# by ambient light alone: each pixel's surface is found from where it lies in
-# the maze (its depth, the camera's pose, the walls' grid), then its colour is
-# scaled by the gain of that surface at that depth, read from a table over
-# inverse depth (interpolating per pixel cost several times more on a CPU).
+# by ambient light alone. Doom lights a pixel by one look-up of its surface's
+# light at its depth, and so does this: each pixel's surface is found from its
+# depth, and its colour scaled by that surface's gain at that depth, read from a
+# table over inverse depth (interpolating per pixel cost several times more on a CPU).
+# The camera is level and the walls are full height, so the floor and the
+# ceiling lie at one depth per row and a column sees one wall, the farthest
+# thing in it: the surfaces are worked out per row and per column, and a pixel
+# only compares its depth with its row's and its column's (docs/rendering.md).
 NORTH_SOUTH_WALL, EAST_WEST_WALL, FLOOR, CEILING, THING = range(5)
 _LIGHT_BINS = 1024  # table rows over inverse depth, 0 .. 1 / _NEAREST
 _NEAREST = 0.1  # metres; nearer pixels take this depth's gain
 _ON_PLANE = 0.02  # metres from a wall face, the floor or the ceiling that still count as on it
-# A pixel's code, the sum of what holds for it; _surface_of_code reads it.
-_EAST_WEST, _OFF_WALLS, _ON_FLOOR, _ON_CEILING = 1, 2, 4, 8
 
 
 def light_table() -> np.ndarray:
@@ -194,17 +196,6 @@ def light_table() -> np.ndarray:
     light = {NORTH_SOUTH_WALL: palette.NORTH_SOUTH_WALL_LIGHT, EAST_WEST_WALL: palette.EAST_WEST_WALL_LIGHT,
              FLOOR: palette.FLOOR_LIGHT, CEILING: palette.CEILING_LIGHT, THING: palette.THING_LIGHT}
     return np.stack([light[surface].gain(depth) for surface in range(len(light))]).astype(np.float32)
-
-
-def _surface_of_code(code: int) -> int:
-    """The surface of a pixel whose code is ``code`` (floor and ceiling first, then things, then walls)."""
-    if code & _ON_FLOOR:
-        return FLOOR
-    if code & _ON_CEILING:
-        return CEILING
-    if code & _OFF_WALLS:
-        return THING
-    return EAST_WEST_WALL if code & _EAST_WEST else NORTH_SOUTH_WALL
 
 
 class DoomLight:
@@ -218,17 +209,21 @@ class DoomLight:
         # Tangents of each column's and row's ray (right, up) in Doom's projection (mjcf.set_ego_projection).
         self._right = xp.asarray((np.arange(width) + 0.5 - width / 2) / (mjcf.DOOM_FOCAL_ACROSS * width),
                                  dtype=xp.float32, device=device)
-        self._up = xp.asarray((height / 2 - np.arange(height) - 0.5) / (mjcf.DOOM_FOCAL_DOWN * height),
-                              dtype=xp.float32, device=device)
-        # The gains by (code, inverse depth), each repeated for the three channels:
-        # numpy multiplies by a gain broadcast over the channels several times slower.
-        gains = light_table()[[_surface_of_code(code) for code in range(16)]]
-        self._gains = xp.asarray(np.repeat(gains.reshape(-1, 1), 3, axis=1), device=device)
+        up = (height / 2 - np.arange(height) - 0.5) / (mjcf.DOOM_FOCAL_DOWN * height)
+        self._up = xp.asarray(np.abs(up), dtype=xp.float32, device=device)
+        self._below = xp.asarray(up < 0, device=device)
+        # The gains by (surface, inverse depth), in one row (a surface's starts at surface x bins).
+        self._gains = xp.asarray(light_table().reshape(-1), device=device)
+        # A pixel's surface as where its gains start in the table.
+        self._flat_start = xp.asarray(np.where(up < 0, FLOOR, CEILING)[:, None] * _LIGHT_BINS, dtype=xp.int32,
+                                      device=device)  # (H, 1)
+        self._thing_start = THING * _LIGHT_BINS
         self._cell, self._half_grid = float(cell_size), grid_size / 2
         self._face = walls.WALL_THICKNESS / 2 / self._cell  # a wall face's offset from its grid line, in cells
         self._on_face = _ON_PLANE / self._cell
         # An array, not a Python number: xp.minimum with a scalar would make torch build a tensor per call.
         self._white = xp.asarray(254.5, dtype=xp.float32, device=device)
+        self._top_bin = xp.asarray(_LIGHT_BINS - 1, dtype=xp.float32, device=device)
 
     def _off_wall_face(self, cells):
         """Cells from a coordinate (in cells from the grid's first line) to the nearest wall face across it."""
@@ -236,28 +231,129 @@ class DoomLight:
         off_line = xp.abs(cells - xp.round(cells))
         return xp.minimum(xp.abs(off_line - self._face), off_line)  # a wall's side, or an end or the outer wall
 
-    def __call__(self, frames, depth, eye, yaw):
+    def _surface_start(self, eye_x, eye_y, cos, sin, right, depth):
+        """Where the gains of the surface ``depth`` metres ahead along a column's ray start in the table:
+        a wall's side if that point lies on a wall face across x (a wall running north-south) or y
+        (in cells from the grid's first lines), else a thing's."""
+        xp = self._xp
+        x = eye_x / self._cell + self._half_grid + depth * ((cos + right * sin) / self._cell)
+        y = eye_y / self._cell + self._half_grid + depth * ((sin - right * cos) / self._cell)
+        off_x, off_y = self._off_wall_face(x), self._off_wall_face(y)
+        wall = xp.where(off_y < off_x, EAST_WEST_WALL * _LIGHT_BINS, NORTH_SOUTH_WALL * _LIGHT_BINS)
+        return xp.astype(xp.where(xp.minimum(off_x, off_y) <= self._on_face, wall, self._thing_start), xp.int32)
+
+    def __call__(self, frames, inverse_depth, eye, yaw):
         """``frames`` (uint8 ``(B, H, W, 3)``) in Doom's light: new frames.
 
-        ``depth``: ``(B, H, W)`` metres along the view axis; ``eye``: the
-        camera's ``(B, 3)`` position; ``yaw``: its ``(B,)`` heading (radians).
+        ``inverse_depth``: ``(B, H, W)`` float32, 1 / metres along the view
+        axis (GL's depth buffer is affine in it); ``eye``: the camera's
+        ``(B, 3)`` position; ``yaw``: its ``(B,)`` heading (radians).
         """
         xp = self._xp
-        yaw, eye = xp.astype(yaw, xp.float32)[:, None, None], xp.astype(eye, xp.float32)[:, None, None, :]
-        cos, sin, right = xp.cos(yaw), xp.sin(yaw), self._right
-        # Where each pixel lies, in cells from the grid's first lines: on a wall
-        # face across x (a wall running north-south), across y, or neither (a thing).
-        x = eye[..., 0] / self._cell + self._half_grid + depth * ((cos + right * sin) / self._cell)
-        y = eye[..., 1] / self._cell + self._half_grid + depth * ((sin - right * cos) / self._cell)
-        off_x, off_y = self._off_wall_face(x), self._off_wall_face(y)
-        code = (_EAST_WEST * xp.astype(off_y < off_x, xp.int32)
-                + _OFF_WALLS * xp.astype(xp.minimum(off_x, off_y) > self._on_face, xp.int32))
-        # The floor and the ceiling: pixels as deep as their row's ray meets the plane.
-        up = self._up[:, None]
-        plane = xp.where(up < 0, (eye[..., 2] - _ON_PLANE) / -up, (walls.WALL_HEIGHT - _ON_PLANE - eye[..., 2]) / up)
-        code = xp.where(depth > plane, xp.where(up < 0, _ON_FLOOR, _ON_CEILING), code)
-        bins = xp.astype(rules.at_most(xp, (_LIGHT_BINS * _NEAREST) / depth, _LIGHT_BINS - 1), xp.int32)
-        gain = xp.take(self._gains, xp.reshape(code * _LIGHT_BINS + bins, (-1,)), axis=0)
+        eye, yaw = xp.astype(eye, xp.float32), xp.astype(yaw, xp.float32)
+        cos, sin = xp.cos(yaw), xp.sin(yaw)
+        # The floor and the ceiling: pixels at least as deep as their row's ray meets the plane.
+        height_above = xp.where(self._below, eye[:, 2:3] - _ON_PLANE, walls.WALL_HEIGHT - _ON_PLANE - eye[:, 2:3])
+        flat = inverse_depth < (self._up / height_above)[:, :, None]  # (B, H, W)
+        # A column's wall is the deepest pixel in it (all else stands before it): its surface is the column's.
+        wall_depth = 1 / xp.min(inverse_depth, axis=1)  # (B, W)
+        wall_start = self._surface_start(eye[:, 0:1], eye[:, 1:2], cos[:, None], sin[:, None], self._right, wall_depth)
+        on_wall = inverse_depth <= (1 / (wall_depth - _ON_PLANE))[:, None, :]
+        start = xp.where(flat, self._flat_start, xp.where(on_wall, wall_start[:, None, :], self._thing_start))
+        # The pixels before the wall (things) take the surface of where they lie, as each pixel did
+        # before (a thing across a grid line is lit as a wall there): found per pixel, few on a CPU.
+        before = ~(flat | on_wall)
+        if rules.on_host(xp):
+            pixels = np.flatnonzero(before)
+            if len(pixels):
+                world, row, column = np.unravel_index(pixels, before.shape)
+                start[world, row, column] = self._surface_start(
+                    eye[world, 0], eye[world, 1], cos[world], sin[world], self._right[column],
+                    1 / inverse_depth[world, row, column])
+        else:  # every pixel: picking some out would wait on the GPU
+            every = self._surface_start(eye[:, 0, None, None], eye[:, 1, None, None], cos[:, None, None],
+                                        sin[:, None, None], self._right, 1 / inverse_depth)
+            start = xp.where(before, every, start)
+        bins = xp.astype(xp.minimum(inverse_depth * (_LIGHT_BINS * _NEAREST), self._top_bin), xp.int32)
+        gain = xp.reshape(xp.take(self._gains, xp.reshape(start + bins, (-1,))), start.shape)
         # Saturate, as Doom's brightest colormap does: a bright sprite near the eye goes past 255.
-        lit = xp.minimum(xp.astype(frames, xp.float32) * xp.reshape(gain, frames.shape), self._white)
+        lit = xp.minimum(xp.astype(frames, xp.float32) * gain[..., None], self._white)
         return xp.astype(lit + 0.5, xp.uint8)
+
+
+class FramePipeline:
+    """What Doom draws beyond the 3D scene, for a batch of views: the one path of both backends.
+
+    Before the render, :meth:`scene` works out what the renderer must draw
+    differently per world (the eye's head-bob, the sprites turned to the
+    camera at their animation frame and depth); after it, :meth:`finish` lights
+    the frames (:class:`DoomLight`) and draws the pistol and the flashes. Both
+    take a batch of worlds and the rules' state (:class:`mjmaze.core.EpisodeState`)
+    on numpy or torch (``xp``): a CPU process calls them once per step with
+    all its envs (:func:`mjmaze.tasks.base.observe`), the MuJoCo Warp backend with
+    every world (:mod:`mjmaze.warp`). Made once per model and device.
+    """
+
+    def __init__(self, xp, device, task, model: mujoco.MjModel):
+        self._xp, self._device = xp, device
+        self._width, self._height = task.width, task.height
+        textured = task.visual_style == "textured"
+        self.sprites = SpriteView(xp, device, model, task.objects, task.width) if textured else None
+        self.light = (DoomLight(xp, device, task.width, task.height, task.layout.grid_size, task.layout.cell_size)
+                      if textured else None)
+        self._head_bob, self._pistol, self._flashes = task.head_bob, task.draws_pistol, task.flashes
+        if self.sprites is not None and len(self.sprites):
+            self._sprite_objects = xp.asarray(self.sprites.object_index, device=device)
+
+    @property
+    def needs_depth(self) -> bool:
+        """Whether :meth:`finish` reads the frames' depth (Doom's light, in the textured style)."""
+        return self.light is not None
+
+    def scene(self, state: dict, xy, yaw, bob, sprite_xy) -> dict:
+        """What to draw per world: ``eye_dz`` ``(B,)`` (metres over the eye's height; head-bob),
+        ``pistol`` ``(dx, dy)`` ``(B,)`` int pixels, and with sprites ``sprite_material`` ``(B, n)``
+        and ``sprite_quat`` ``(B, 4)`` (:class:`SpriteView`, its ``geom_ids``).
+
+        ``state``: the rules' state of the batch; ``xy`` ``(B, 2)`` and ``yaw``
+        ``(B,)``: the agents' poses; ``bob`` ``(B,)``: Doom's walking bob of their last tic;
+        ``sprite_xy`` ``(B, n, 2)``: where the sprite geoms stand in the models (None without sprites).
+        """
+        xp = self._xp
+        scene = {}
+        if self._head_bob:
+            eye_dz, pistol_dx, pistol_dy = view_bob(xp, bob, state["steps"] * core.TICS_PER_STEP)
+            scene["eye_dz"] = eye_dz
+            scene["pistol"] = (xp.astype(xp.round(pistol_dx * self._width), xp.int64),
+                               xp.astype(xp.round(pistol_dy * self._height), xp.int64))
+        else:
+            still = xp.zeros(state["steps"].shape, dtype=xp.int64, device=self._device)
+            scene["eye_dz"], scene["pistol"] = xp.astype(still, xp.float64), (still, still)
+        if self.sprites is not None and len(self.sprites):
+            clock = core.FIRST_OBSERVATION_TIC + state["steps"] * core.TICS_PER_STEP
+            objects = self._sprite_objects
+            ages = clock[:, None] - xp.take(state["animation_start"], objects, axis=1)
+            scene["sprite_material"], scene["sprite_quat"] = self.sprites(ages, xy, yaw, sprite_xy)
+        return scene
+
+    def finish(self, frames, inverse_depth, eye, yaw, state: dict, scene: dict):
+        """The observations of frames the renderer drew (uint8 ``(B, H, W, 3)``): new frames.
+
+        ``inverse_depth`` ``(B, H, W)`` (1 / metres; None without Doom's
+        light), the eye's ``(B, 3)`` position and ``(B,)`` heading, the state
+        and the :meth:`scene` the frames were drawn with.
+        """
+        xp = self._xp
+        if self.light is not None:
+            frames = self.light(frames, inverse_depth, eye, yaw)
+        if self._pistol:
+            draw_pistol(xp, frames, *scene["pistol"])
+        if self._flashes:
+            rgb, alpha = rules.flash(xp, state["damage_count"], state["bonus_count"])
+            if rules.on_host(xp):  # most frames have no flash: no work for them
+                flashed = np.flatnonzero(alpha > 0)
+                if len(flashed):
+                    frames[flashed] = tint(xp, frames[flashed], rgb[flashed], alpha[flashed])
+            else:  # every world, flashed or not: picking the flashed ones out would wait on the GPU
+                frames = tint(xp, frames, rgb, alpha)
+        return frames

@@ -258,6 +258,20 @@ class EgoRenderer:
             np.divide(self._near, 1 - self._depth_buffer[::-1] * (1 - self._near_over_far), out=self.depth)
         return self._frame
 
+    def render_into(self, data: mujoco.MjData, rgb: np.ndarray, depth: np.ndarray | None = None) -> None:
+        """Renders the current state into ``rgb`` (uint8 ``(H, W, 3)``) and ``depth`` (float32 ``(H, W)``,
+        GL's depth buffer: :meth:`inverse_depth`), contiguous arrays, rows bottom-up as GL reads them."""
+        mujoco.mj_kinematics(self._model, data)
+        mujoco.mj_camlight(self._model, data)
+        mujoco.mjv_updateScene(self._model, data, self._option, self._perturb, self._camera, self._catmask, self._scene)
+        mujoco.mjr_setBuffer(self._offscreen, self._context)
+        mujoco.mjr_render(self._viewport, self._scene, self._context)
+        mujoco.mjr_readPixels(rgb, depth, self._viewport, self._context)
+
+    def inverse_depth(self, depth: np.ndarray) -> np.ndarray:
+        """1 / metres along the view axis of GL's depth buffer values ``depth`` (affine in them)."""
+        return (1 - depth * (1 - self._near_over_far)) * (1 / self._near)
+
     def segmentation(self, data: mujoco.MjData) -> np.ndarray:
         """``(H, W)`` int: the geom id drawn at each pixel of the current state, -1 for none (sky)."""
         flags = (mujoco.mjtRndFlag.mjRND_SEGMENT, mujoco.mjtRndFlag.mjRND_IDCOLOR)

@@ -30,6 +30,7 @@ memory.
 from __future__ import annotations
 
 import contextlib
+import math
 import multiprocessing as mp
 import multiprocessing.connection
 import os
@@ -46,7 +47,8 @@ import numpy as np
 from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode
 
-from mjmaze import batch, registry, suite
+from mjmaze import batch, core, registry, suite
+from mjmaze import physics as physics_module
 from mjmaze.tasks import base
 
 SHARED_MEMORY_PREFIX = "mjmaze_"
@@ -137,6 +139,7 @@ class _EnvGroup:
                 task.share_state(self._state, row)
             self._paths = np.zeros((len(tasks), base.TICS_PER_STEP, 2))
             self._rules = tasks[0]  # every env's task is the same scenario core (mjmaze.core.MazeRules)
+            self._tasks, self._physics = tasks, [physics for _, _, _, physics in self._envs]
 
     def _restart(self, i: int, slot: int, env) -> None:
         env.reset()  # renders the first frame into the env's slot
@@ -149,33 +152,60 @@ class _EnvGroup:
     def step(self) -> None:
         columns, actions, paths = self._columns, self._actions, self._paths
         envs = self._envs
-        for i, (slot, _, task, physics) in enumerate(envs):
-            if not self._ended[i]:
-                task.before_step(actions[slot], physics)
-                physics.step(base.TICS_PER_STEP)
-                paths[i] = physics.tic_xy
+        playing = [i for i in range(len(envs)) if not self._ended[i]]
+        for i in playing:
+            slot, _, task, physics = envs[i]
+            task.before_step(actions[slot], physics)
+        # Every playing env's tics at once (mjmaze.physics.step_group).
+        physics_module.step_group([envs[i][3] for i in playing], base.TICS_PER_STEP)
+        for i in playing:
+            paths[i] = envs[i][3].tic_xy
         # The rules for every env of the group at once. An env about to restart
         # (its episode ended on the last step) goes through them too, on its
         # old state, which its restart then replaces.
         rewards, terminated, truncated = self._rules.step_state(np, self._state, paths)
-        for i, (slot, env, task, physics) in enumerate(envs):
+        for i in range(len(envs)):
             if self._ended[i]:  # the step after an episode's end: its action is ignored
-                self._restart(i, slot, env)
-                continue
-            ended = bool(terminated[i])
-            task.finish_step(physics, float(rewards[i]), ended)
-            task.get_observation(physics)
-            columns["reward"][slot] = rewards[i]
-            columns["terminated"][slot] = ended
-            columns["truncated"][slot] = truncated[i]
-            if ended or truncated[i]:
+                self._restart(i, envs[i][0], envs[i][1])
+        if not playing:
+            return
+        for i in playing:
+            _, _, task, physics = envs[i]
+            task.finish_step(physics, float(rewards[i]), bool(terminated[i]))
+        # Every playing env's frame at once, into its slot (the group's slots are consecutive).
+        slots = [envs[i][0] for i in playing]
+        if len(playing) == len(envs):
+            base.observe(self._tasks, self._physics, self._obs[slots[0] : slots[-1] + 1])
+        else:
+            frames = np.empty((len(playing), *self._obs.shape[1:]), dtype=np.uint8)
+            base.observe([envs[i][2] for i in playing], [envs[i][3] for i in playing], frames)
+            self._obs[slots] = frames
+        columns["reward"][slots] = rewards[playing]
+        columns["terminated"][slots] = terminated[playing]
+        columns["truncated"][slots] = truncated[playing]
+        self._write_infos(columns, playing)
+        for i in playing:
+            if terminated[i] or truncated[i]:
                 if not self._same_step:
                     self._ended[i] = True
-                else:
-                    self._final_obs[slot] = self._obs[slot]
-                    _write_info(self._final_columns, slot, task.get_info(physics))
-                    env.reset()
-            _write_info(columns, slot, task.get_info(physics))
+                    continue
+                slot, env, task, physics = envs[i]
+                self._final_obs[slot] = self._obs[slot]
+                _write_info(self._final_columns, slot, task.get_info(physics))
+                env.reset()
+                _write_info(columns, slot, task.get_info(physics))
+
+    def _write_infos(self, columns: dict[str, np.ndarray], playing: list[int]) -> None:
+        """The ``info`` fields of the envs ``playing`` (indices into the group), from the group's state at once."""
+        envs, state = self._envs, self._state
+        pose = np.array([envs[i][3].data.qpos[:3] for i in playing])
+        yaw = [math.remainder(value, math.tau) for value in pose[:, 2]]  # as MazePhysics.agent_pose
+        metrics = {name: value[playing] for name, value in self._rules.episode_metrics(state).items()}
+        fields = core.episode_info(metrics, pose[:, 0], pose[:, 1], yaw, state["steps"][playing],
+                                   state["episode_return"][playing], [envs[i][2].config.index for i in playing])
+        slots = [envs[i][0] for i in playing]
+        for name, value in fields.items():
+            columns[name][slots] = value
 
     def close(self) -> None:
         for _, _, task, _ in self._envs:

@@ -168,7 +168,9 @@ class MazeBatchEnv(batch.BatchEnv):
         self._wall_visual = geom("walls_visual")
         self._object_ids = torch.tensor([geom(obj.name) for obj in task.objects], dtype=torch.long, device=dev)
         self._object_z = torch.tensor([obj.z for obj in task.objects], dtype=torch.float32, device=dev)
-        self._sprites = look.SpriteView(self.xp, dev, mjm, task.objects, width) if task.visual_style == "textured" else None
+        # What Doom draws beyond the scene, for every world at once: the CPU envs' pipeline.
+        self._pipeline = look.FramePipeline(self.xp, dev, task, mjm)
+        self._sprites = self._pipeline.sprites
         self._sprite_ids = torch.as_tensor(self._sprites.geom_ids if self._sprites else [], dtype=torch.long, device=dev)
         self._sprite_objects = torch.as_tensor(self._sprites.object_index if self._sprites else [], dtype=torch.long,
                                                device=dev)
@@ -207,8 +209,6 @@ class MazeBatchEnv(batch.BatchEnv):
         self._rgb_packed = wp.to_torch(self._render.rgb_data)
         self._depth = wp.to_torch(self._render.depth_data).view(n, height, width) if textured else None
         self._cam_xpos = wp.to_torch(self._data.cam_xpos)
-        self._light = (look.DoomLight(self.xp, dev, width, height, task.layout.grid_size, task.layout.cell_size)
-                       if textured else None)
         self._stream = wp.stream_from_torch(torch.cuda.current_stream(dev)) if dev.type == "cuda" else None
 
         self._seed_keys = torch.zeros(n, dtype=torch.int64, device=dev)
@@ -370,32 +370,23 @@ class MazeBatchEnv(batch.BatchEnv):
             return
         m, d, rc = self._model, self._data, self._render
         task = self.task
+        sprite_xy = self._geom_pos[:, self._sprite_ids, 0:2] if len(self._sprite_ids) else None
+        scene = self._pipeline.scene(self.state, self._qpos[:, 0:2], self._qpos[:, 2], self._bob, sprite_xy)
         if task.head_bob:
-            eye_dz, pistol_dx, pistol_dy = look.view_bob(self.xp, self._bob, self.state["steps"] * core.TICS_PER_STEP)
-            self._cam_pos[:, self._camera, 2] = (mjcf.EYE_HEIGHT + eye_dz).float()
+            self._cam_pos[:, self._camera, 2] = (mjcf.EYE_HEIGHT + scene["eye_dz"]).float()
         if len(self._sprite_ids):  # Doom's sprites: facing the camera, at their animation frame and depth
-            clock = core.FIRST_OBSERVATION_TIC + self.state["steps"] * core.TICS_PER_STEP
-            ages = clock[:, None] - self.state["animation_start"][:, self._sprite_objects]
-            materials, quat = self._sprites(ages, self._qpos[:, 0:2], self._qpos[:, 2], self._geom_pos[:, self._sprite_ids, 0:2])
-            self._geom_matid[:, self._sprite_ids] = materials.int()
-            self._geom_quat[:, self._sprite_ids] = quat[:, None, :].float()
+            self._geom_matid[:, self._sprite_ids] = scene["sprite_material"].int()
+            self._geom_quat[:, self._sprite_ids] = scene["sprite_quat"][:, None, :].float()
         mjw.kinematics(m, d)  # positions lag a step behind mjw.step's integration
         mjw.camlight(m, d)
         mjw.refit_bvh(m, d, rc)
         mjw.render(m, d, rc)
         # Packed 0xAABBGGRR per pixel: bytes R, G, B, A in memory.
         packed = self._rgb_packed.view(torch.uint8).view(self.num_envs, task.height, task.width, 4)
-        self._obs.copy_(packed[..., [2, 1, 0]])
+        inverse_depth = 1 / self._depth if self._depth is not None else None
         # Doom's light and what Doom draws over the scene, as on the CPU (mjmaze.look).
-        if self._light is not None:
-            self._obs.copy_(self._light(self._obs, self._depth, self._cam_xpos[:, self._camera], self._qpos[:, 2]))
-        if task.draws_pistol:
-            still = torch.zeros(self.num_envs, dtype=torch.long, device=self.device)
-            dx = torch.round(pistol_dx * task.width).long() if task.head_bob else still
-            dy = torch.round(pistol_dy * task.height).long() if task.head_bob else still
-            look.draw_pistol(self.xp, self._obs, dx, dy)
-        if task.flashes:  # every world, flashed or not: picking the flashed ones out would wait on the GPU
-            self._obs.copy_(look.flash(self.xp, self._obs, self.state["damage_count"], self.state["bonus_count"]))
+        self._obs.copy_(self._pipeline.finish(packed[..., [2, 1, 0]], inverse_depth, self._cam_xpos[:, self._camera],
+                                              self._qpos[:, 2], self.state, scene))
 
     def segmentation(self) -> torch.Tensor:
         """``(N, H, W)`` geom id drawn at each pixel of the last frames, -1 for none (needs ``render_segmentation``)."""

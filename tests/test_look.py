@@ -373,7 +373,7 @@ def test_doom_s_light_saturates_a_bright_pixel_near_the_eye_instead_of_wrapping_
     # ~2.7 near the eye: a bright pixel must stay the brightest, not wrap to a dark one.
     light = look.DoomLight(np, "cpu", 112, 64, grid_size=5, cell_size=1.25)
     frames = np.full((1, 64, 112, 3), 200, dtype=np.uint8)
-    lit = light(frames, np.full((1, 64, 112), 0.3), np.array([[0.1, 0.1, mjcf.EYE_HEIGHT]]), np.zeros(1))
+    lit = light(frames, np.full((1, 64, 112), 1 / 0.3, dtype=np.float32), np.array([[0.1, 0.1, mjcf.EYE_HEIGHT]]), np.zeros(1))
     assert lit.min() >= 250
 
 

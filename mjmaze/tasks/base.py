@@ -14,6 +14,7 @@ from __future__ import annotations
 import collections
 import functools
 import math
+from collections.abc import Sequence
 
 import mujoco
 import numpy as np
@@ -45,7 +46,6 @@ class MazeTask(core.MazeRules, base.Task):
         ``numpy.random.RandomState`` for the episodes' draws (dm_control's ``Task`` argument)."""
         base.Task.__init__(self, random=random)
         super().__init__(*args, **kwargs)
-        self._tints: dict[tuple[int, int], tuple[np.ndarray, float]] = {}
         self._episode = 0
         self._seed_key = rules.seed_key(self.random)
         #: Where observations go: None = a fresh array per observation; an array
@@ -85,16 +85,15 @@ class MazeTask(core.MazeRules, base.Task):
         self._qpos, self._qvel = data.qpos, data.qvel
         self._walls = walls.WallLayout(model, self.layout.grid_size, self.layout.cell_size)
         mjcf.set_ego_projection(model, self.width, self.height)
-        textured = self.visual_style == "textured"
-        self._renderer = render.EgoRenderer(model, CAMERA, self.width, self.height, depth=textured)
-        self._light = (look.DoomLight(np, "cpu", self.width, self.height, self.layout.grid_size, self.layout.cell_size)
-                       if textured else None)
-        self._camera_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, CAMERA)
+        self._pipeline = look.FramePipeline(np, "cpu", self, model)
+        self._renderer = render.EgoRenderer(model, CAMERA, self.width, self.height, depth=self._pipeline.needs_depth)
         self._eye = model.cam(CAMERA).pos  # a view into the model: head-bob moves it
         self.horizontal_fov = mjcf.EGO_HORIZONTAL_FOV
         self._config_in_model = None
         self._object_ids = physics.object_ids([geom.name for geom in self.objects])[1]
-        self._sprites = look.SpriteView(np, "cpu", model, self.objects, self.width) if textured else None
+        sprites = self._pipeline.sprites
+        self._sprite_ids = sprites.geom_ids if sprites is not None and len(sprites) else None
+        self._buffers: tuple[np.ndarray, np.ndarray | None] | None = None
 
     def initialize_episode(self, physics: MazePhysics) -> None:
         self._bind(physics)
@@ -173,52 +172,37 @@ class MazeTask(core.MazeRules, base.Task):
 
     def get_observation(self, physics: MazePhysics) -> collections.OrderedDict:
         self._bind(physics)
-        pistol_shift = self._bob_view(physics)
-        data = self._bound_data
-        self._face_sprites()
-        frame = self._renderer.render(data)
-        if self._light is not None:
-            eye, yaw = data.cam_xpos[self._camera_id], data.qpos[2:3]
-            frame = self._light(frame[None], self._renderer.depth[None], eye[None], yaw)[0]
-        if self.draws_pistol:
-            look.draw_pistol(np, frame[None], *np.array(pistol_shift)[:, None])
-        if self.flashes:
-            counts = int(self.state["damage_count"][self.row]), int(self.state["bonus_count"][self.row])
-            if any(counts):  # most frames have no flash: no work for them
-                tint = self._tints.get(counts)
-                if tint is None:  # a few dozen pairs occur: each worked out once
-                    rgb, alpha = rules.flash(np, np.array(counts[:1]), np.array(counts[1:]))
-                    tint = self._tints[counts] = rgb[0], alpha[0]
-                frame[...] = look.tint(np, frame, *tint)
         if self.observation_buffer is None:
-            return collections.OrderedDict(pixels=frame.copy())
-        np.copyto(self.observation_buffer, frame)
-        return collections.OrderedDict(pixels=self.observation_buffer)
+            frame = np.empty((1, self.height, self.width, 3), dtype=np.uint8)
+        else:
+            frame = self.observation_buffer[None]
+        observe([self], [physics], frame)
+        return collections.OrderedDict(pixels=frame[0])
 
     def segmentation(self, physics: MazePhysics) -> np.ndarray:
         """``(H, W)``: the geom id the agent sees at each pixel of its view, -1 for none (the sky)."""
         self._bind(physics)
-        self._bob_view(physics)
-        self._face_sprites()
+        state = _rows(self.state, [self.row])
+        pose = np.array([physics.data.qpos[:3]])
+        scene = self._pipeline.scene(state, pose[:, :2], pose[:, 2], np.array([physics.bob]), _sprite_xy([self]))
+        self._set_view(scene, 0)
         return self._renderer.segmentation(self._bound_data)
 
-    def _face_sprites(self) -> None:
-        """Turns the sprites to the camera, at their animation frame and depth (:class:`mjmaze.look.SpriteView`)."""
-        if self._sprites is not None and len(self._sprites):
-            clock = core.FIRST_OBSERVATION_TIC + self.steps * TICS_PER_STEP
-            ages = clock - self.state["animation_start"][self.row, self._sprites.object_index]
-            ids, model = self._sprites.geom_ids, self._model
-            materials, quat = self._sprites(ages[None], self._qpos[None, 0:2], self._qpos[2:3], model.geom_pos[None, ids, 0:2])
-            model.geom_matid[ids] = materials[0]
-            model.geom_quat[ids] = quat
+    def _set_view(self, scene: dict, row: int) -> None:
+        """Puts row ``row`` of a :meth:`mjmaze.look.FramePipeline.scene` into this env's model: the eye's
+        height, the sprites' pictures and turns."""
+        self._eye[2] = mjcf.EYE_HEIGHT + scene["eye_dz"][row]
+        if self._sprite_ids is not None:
+            self._model.geom_matid[self._sprite_ids] = scene["sprite_material"][row]
+            self._model.geom_quat[self._sprite_ids] = scene["sprite_quat"][row]
 
-    def _bob_view(self, physics: MazePhysics) -> tuple[int, int]:
-        """Puts the eye where head-bob has it now; returns the pistol's shift in pixels (right, down)."""
-        if not self.head_bob:
-            return 0, 0
-        eye_dz, pistol_dx, pistol_dy = look.view_bob(math, physics.bob, self.steps * TICS_PER_STEP)
-        self._eye[2] = mjcf.EYE_HEIGHT + eye_dz
-        return round(pistol_dx * self.width), round(pistol_dy * self.height)
+    def _frame_buffers(self, envs: int) -> tuple[np.ndarray, np.ndarray | None]:
+        """GL's colour and depth buffers for ``envs`` frames (bottom-up rows), kept between calls."""
+        if self._buffers is None or len(self._buffers[0]) != envs:
+            rgb = np.empty((envs, self.height, self.width, 3), dtype=np.uint8)
+            depth = np.empty((envs, self.height, self.width), dtype=np.float32) if self._pipeline.needs_depth else None
+            self._buffers = rgb, depth
+        return self._buffers
 
     def get_reward(self, physics: MazePhysics) -> float:
         return self._reward
@@ -267,6 +251,41 @@ class MazeTask(core.MazeRules, base.Task):
             self._renderer.close()
             self._renderer = None
         self._bound_data = None
+
+
+def observe(tasks: Sequence[MazeTask], physics: Sequence[MazePhysics], out: np.ndarray) -> None:
+    """Draws what the agents of ``tasks`` see into ``out`` (uint8 ``(len(tasks), H, W, 3)``).
+
+    ``tasks`` play one scenario and share one state (a vector env's group, or
+    one env alone); each env's ``physics`` is bound to its task. The frame
+    pipeline (:class:`mjmaze.look.FramePipeline`) runs once for all of them:
+    per env only its model's view is set and GL draws it.
+    """
+    first = tasks[0]
+    pipeline = first._pipeline
+    state = _rows(first.state, [task.row for task in tasks])
+    pose = np.array([task._qpos[:3] for task in tasks])
+    scene = pipeline.scene(state, pose[:, :2], pose[:, 2], np.array([p.bob for p in physics]), _sprite_xy(tasks))
+    rgb, depth = first._frame_buffers(len(tasks))
+    for row, task in enumerate(tasks):
+        task._set_view(scene, row)
+        task._renderer.render_into(task._bound_data, rgb[row], None if depth is None else depth[row])
+    inverse_depth = None if depth is None else first._renderer.inverse_depth(depth[:, ::-1])
+    eye = np.concatenate([pose[:, :2], mjcf.EYE_HEIGHT + np.asarray(scene["eye_dz"])[:, None]], axis=1)
+    out[...] = pipeline.finish(rgb[:, ::-1], inverse_depth, eye, pose[:, 2], state, scene)
+
+
+def _sprite_xy(tasks: Sequence[MazeTask]) -> np.ndarray | None:
+    """``(B, n, 2)``: where each env's model has its sprites (placed by the rules' state, or by hand)."""
+    ids = tasks[0]._sprite_ids
+    return None if ids is None else np.stack([task._model.geom_pos[ids, :2] for task in tasks])
+
+
+def _rows(state: dict[str, np.ndarray], rows: list[int]) -> dict[str, np.ndarray]:
+    """``state`` at ``rows``: the arrays themselves when they are every row in order."""
+    if rows == list(range(len(state["steps"]))):
+        return state
+    return {name: value[rows] for name, value in state.items()}
 
 
 @functools.cache
