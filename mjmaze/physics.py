@@ -65,8 +65,7 @@ class MazePhysics(mujoco.Physics):
         """Advances ``nstep`` tics of :attr:`command`; walls and pillars stop the agent at its radius.
 
         Each tic moves the agent as Doom does (:func:`tic_motion`, then
-        friction): :func:`step_group` with this env alone, which a vector env's
-        process calls with all its envs. Collisions are found where the agent will be at the end of
+        friction). Collisions are found where the agent will be at the end of
         the tic (positions moved ahead by ``qvel * dt`` for ``mj_step``, then
         moved back), and the arena's contacts (see ``xml_templates/arena.xml``)
         take exactly the predicted penetration out of the velocity, so momentum
@@ -75,7 +74,48 @@ class MazePhysics(mujoco.Physics):
         finds a contact only after the agent has sunk up to a tic's travel
         (6 cm) into a wall, then pushes it back: a 6 cm jitter against every wall.
         """
-        step_group([self], nstep)
+        model, data = self.model.ptr, self.data.ptr
+        qpos, qvel, dt = data.qpos, data.qvel, model.opt.timestep
+        forward, turn = self.command
+        if len(self.tic_xy) != nstep:
+            self.tic_xy = np.zeros((nstep, 2))
+        tic_xy = self.tic_xy
+        # Plain floats and math between the tics: numpy's per-call cost on
+        # 1-element reads and writes is a fair part of a tic here.
+        vx, vy, held = float(qvel[0]), float(qvel[1]), self.turn_held
+        with self.check_invalid_state():
+            for tic in range(nstep):
+                vx, vy, yaw_rate, held = tic_motion(math, vx, vy, float(qpos[2]), forward, turn, held, dt)
+                qvel[0], qvel[1], qvel[2] = vx, vy, yaw_rate
+                thrust_vx, thrust_vy = vx, vy  # Doom's bob reads the velocity here
+                # Only x and y matter (the agent's box rides the slide joints).
+                ahead_x, ahead_y = vx * dt, vy * dt
+                qpos[0] += ahead_x
+                qpos[1] += ahead_y
+                mj.mj_step(model, data)
+                qpos[0] -= ahead_x
+                qpos[1] -= ahead_y
+                # The contacts took away the velocity into walls; friction keeps a share of the rest,
+                # less Doom's slide-move loss where a contact stopped the agent.
+                slid_x, slid_y = float(qvel[0]), float(qvel[1])
+                dx, dy = vx - slid_x, vy - slid_y  # the velocity the contacts took (into the wall)
+                stopped = dx * dx + dy * dy
+                if stopped > _BLOCKED_SQ:
+                    # Doom moves the player up to the wall, then slides the rest of the tic's move
+                    # along it, and keeps as velocity only that rest (ZDoom's FSlide::SlideMove): the
+                    # share of the tic spent reaching the wall, at least its 1/32 fudge, is lost.
+                    closing = slid_x * dx + slid_y * dy  # the part of the move into the wall that was left
+                    # (a contact that pushed the agent out, closing <= -stopped, keeps the steady 31/32)
+                    reached = min(max(closing / max(closing + stopped, _BLOCKED_SQ), 1 - SLIDE_KEEP), 1.0)
+                    keep = FRICTION * (1.0 - reached)
+                else:
+                    keep = FRICTION
+                vx, vy = slid_x * keep, slid_y * keep
+                tic_xy[tic] = qpos[:2]
+        qvel[0], qvel[1] = vx, vy
+        self.turn_held = held
+        if nstep:
+            self.bob = float(look.walking_bob(np, thrust_vx, thrust_vy, dt))
 
     def agent_pose(self) -> tuple[float, float, float]:
         """``(x, y, yaw)`` of the agent; yaw in radians in ``(-pi, pi]``, 0 facing +x."""
@@ -124,39 +164,18 @@ class MazePhysics(mujoco.Physics):
         self.model.ptr.geom_rgba[geom_id] = rgba
 
 
-def step_group(group: Sequence[MazePhysics], tics: int) -> None:
-    """Advances every physics of ``group`` (a vector env's process's envs, or one) ``tics`` tics of its
-    :attr:`~MazePhysics.command`: :func:`batch_tics` over their agents, each env's contacts its own ``mj_step``."""
-    qpos = np.array([p.data.qpos[:3] for p in group])
-    qvel = np.array([p.data.qvel[:3] for p in group])
-    commands = np.array([p.command for p in group], dtype=np.float64)
-    held = np.array([p.turn_held for p in group], dtype=np.int64)
-    path = np.empty((len(group), tics, 2))
-    datas = [(p.model.ptr, p.data.ptr) for p in group]
-
-    def step_contacts() -> None:
-        for (model, data), position, velocity in zip(datas, qpos, qvel):
-            data.qpos[:3], data.qvel[:3] = position, velocity
-            mj.mj_step(model, data)
-            position[:], velocity[:] = data.qpos[:3], data.qvel[:3]
-
-    with group[0].check_invalid_state():
-        held, bob = batch_tics(np, qpos, qvel, commands[:, 0], commands[:, 1], held, group[0].model.opt.timestep,
-                               path, step_contacts)
-    for p, position, velocity, turn_held, last_bob, tic_xy in zip(group, qpos, qvel, held, bob, path):
-        p.data.qpos[:3], p.data.qvel[:3] = position, velocity
-        p.turn_held, p.bob, p.tic_xy = int(turn_held), float(last_bob), tic_xy
-
-
 def batch_tics(xp, qpos, qvel, forward, turn, turn_held, timestep: float, path, step_contacts) -> tuple:
-    """Doom's motion of a batch of agents for ``path.shape[1]`` tics, on numpy (a CPU process's envs:
-    :func:`step_group`) or torch (every world of the MuJoCo Warp backend).
+    """:meth:`MazePhysics.step` for a batch of worlds (the MuJoCo Warp backend): ``path.shape[1]`` tics.
 
     ``qpos``, ``qvel`` ``(B, n)`` (x, y, yaw first; written in place),
     ``forward``, ``turn`` and ``turn_held`` ``(B,)``; ``step_contacts()``
-    advances every world one tic (``mj_step`` per env, ``mujoco_warp.step``) with
-    ``qpos``, ``qvel`` and writes them back; ``path`` ``(B, tics, 2)`` receives
-    each tic's ``(x, y)``. Returns ``(turn_held, bob)``.
+    advances every world one tic (``mujoco_warp.step``); ``path`` ``(B, tics,
+    2)`` receives each tic's ``(x, y)``. The same arithmetic as
+    :meth:`MazePhysics.step`, which runs it on floats for one env: numpy's
+    per-call cost on small arrays made this function slower on the CPU, for one
+    env (337 against 67 us per agent step) and for a vector env's process's
+    8 envs (706 against 682 us per env step, frames included; docs/speed.md).
+    tests/test_warp.py holds the two to the same poses. Returns ``(turn_held, bob)``.
     """
     for tic in range(path.shape[1]):
         vx, vy, yaw_rate, turn_held = tic_motion(
