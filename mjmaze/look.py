@@ -302,6 +302,7 @@ class FramePipeline:
         self.light = (DoomLight(xp, device, task.width, task.height, task.layout.grid_size, task.layout.cell_size)
                       if textured else None)
         self._head_bob, self._pistol, self._flashes = task.head_bob, task.draws_pistol, task.flashes
+        self._tints: dict[tuple[int, int], tuple] = {}  # (damage, bonus) -> the flash's (rgb, alpha), on numpy
         if self.sprites is not None and len(self.sprites):
             self._sprite_objects = xp.asarray(self.sprites.object_index, device=device)
 
@@ -348,12 +349,14 @@ class FramePipeline:
             frames = self.light(frames, inverse_depth, eye, yaw)
         if self._pistol:
             draw_pistol(xp, frames, *scene["pistol"])
-        if self._flashes:
-            rgb, alpha = rules.flash(xp, state["damage_count"], state["bonus_count"])
-            if rules.on_host(xp):  # most frames have no flash: no work for them
-                flashed = np.flatnonzero(alpha > 0)
-                if len(flashed):
-                    frames[flashed] = tint(xp, frames[flashed], rgb[flashed], alpha[flashed])
-            else:  # every world, flashed or not: picking the flashed ones out would wait on the GPU
-                frames = tint(xp, frames, rgb, alpha)
+        if self._flashes and rules.on_host(xp):  # most frames have no flash: no work for them
+            damage, bonus = state["damage_count"], state["bonus_count"]
+            for row in np.flatnonzero((damage > 0) | (bonus > 0)):
+                counts = int(damage[row]), int(bonus[row])
+                if counts not in self._tints:  # a few dozen pairs occur: each worked out once
+                    rgb, alpha = rules.flash(np, np.array(counts[:1]), np.array(counts[1:]))
+                    self._tints[counts] = rgb[0], alpha[0]
+                frames[row] = tint(xp, frames[row], *self._tints[counts])
+        elif self._flashes:  # every world, flashed or not: picking the flashed ones out would wait on the GPU
+            frames = tint(xp, frames, *rules.flash(xp, state["damage_count"], state["bonus_count"]))
         return frames
