@@ -212,8 +212,9 @@ class DoomLight:
         up = (height / 2 - np.arange(height) - 0.5) / (mjcf.DOOM_FOCAL_DOWN * height)
         self._up = xp.asarray(np.abs(up), dtype=xp.float32, device=device)
         self._below = xp.asarray(up < 0, device=device)
-        # The gains by (surface, inverse depth), in one row (a surface's starts at surface x bins).
-        self._gains = xp.asarray(light_table().reshape(-1), device=device)
+        # The gains by (surface, inverse depth), a surface's from surface x bins, each repeated for
+        # the three channels: numpy multiplies by a gain broadcast over the channels ~3x slower.
+        self._gains = xp.asarray(np.repeat(light_table().reshape(-1, 1), 3, axis=1), device=device)
         # A pixel's surface as where its gains start in the table.
         self._flat_start = xp.asarray(np.where(up < 0, FLOOR, CEILING)[:, None] * _LIGHT_BINS, dtype=xp.int32,
                                       device=device)  # (H, 1)
@@ -224,6 +225,7 @@ class DoomLight:
         # An array, not a Python number: xp.minimum with a scalar would make torch build a tensor per call.
         self._white = xp.asarray(254.5, dtype=xp.float32, device=device)
         self._top_bin = xp.asarray(_LIGHT_BINS - 1, dtype=xp.float32, device=device)
+        self._half = xp.asarray(0.5, dtype=xp.float32, device=device)
 
     def _off_wall_face(self, cells):
         """Cells from a coordinate (in cells from the grid's first line) to the nearest wall face across it."""
@@ -275,10 +277,10 @@ class DoomLight:
                                         sin[:, None, None], self._right, 1 / inverse_depth)
             start = xp.where(before, every, start)
         bins = xp.astype(xp.minimum(inverse_depth * (_LIGHT_BINS * _NEAREST), self._top_bin), xp.int32)
-        gain = xp.reshape(xp.take(self._gains, xp.reshape(start + bins, (-1,))), start.shape)
+        gain = xp.reshape(xp.take(self._gains, xp.reshape(start + bins, (-1,)), axis=0), frames.shape)
         # Saturate, as Doom's brightest colormap does: a bright sprite near the eye goes past 255.
-        lit = xp.minimum(xp.astype(frames, xp.float32) * gain[..., None], self._white)
-        return xp.astype(lit + 0.5, xp.uint8)
+        lit = xp.minimum(frames * gain, self._white)
+        return xp.astype(lit + self._half, xp.uint8)
 
 
 class FramePipeline:
