@@ -103,6 +103,19 @@ def draw_pistol(xp, frames, dx, dy) -> None:
         frames[...] = xp.where(inside, rules.constant(xp, colour, xp.uint8, dev), frames)
 
 
+# The view's half-width over depth (Doom's projection, mjcf.set_ego_projection), and the
+# margin beyond a picture's reach that still counts as in view.
+_VIEW_TANGENT = 0.5 / mjcf.DOOM_FOCAL_ACROSS
+_VIEW_MARGIN = 0.05  # metres
+
+
+def _mesh_vertices(model: mujoco.MjModel, geom: int) -> np.ndarray:
+    """``(v, 3)``: the vertices of mesh geom ``geom`` in its frame."""
+    mesh = model.geom_dataid[geom]
+    start = model.mesh_vertadr[mesh]
+    return model.mesh_vert[start : start + model.mesh_vertnum[mesh]]
+
+
 class SpriteView:
     """Doom's sprites in a frame: each item's picture turned to face the camera, at its animation
     frame, lit and averaged as ViZDoom's released frames show it at its depth (:func:`mjmaze.sprites.textures`).
@@ -136,6 +149,10 @@ class SpriteView:
                        for f in range(len(kind.frames))]
                 table[k, :, depth_bin] = np.array(ids)[frames]
         self._materials = xp.asarray(table.reshape(-1), device=device)
+        # How far each geom's picture reaches from its spot (metres), a little more: a picture
+        # wholly outside the view's wedge can be left out of the render (:meth:`__call__`'s in_view).
+        reach = [np.linalg.norm(_mesh_vertices(model, int(g))[:, :2], axis=1).max() + _VIEW_MARGIN for g in geoms]
+        self._reach = xp.asarray(np.array(reach, dtype=np.float64), device=device)
         # Where each geom's kind starts in the flat table.
         self._first = xp.asarray(np.array([kinds.index(s) * self._cycle * self._bins for s in of_geom], dtype=np.int64),
                                  device=device)
@@ -145,18 +162,28 @@ class SpriteView:
         return len(self.geom_ids)
 
     def __call__(self, ages, eye_xy, yaw, sprite_xy):
-        """``(geom_matid (B, n), geom_quat (B, 4))`` of the sprite geoms in worlds where each geom's
-        animation began ``ages`` ``(B, n)`` int tics ago, the camera at ``eye_xy`` ``(B, 2)`` heading
-        ``yaw`` ``(B,)``, the geoms at ``sprite_xy`` ``(B, n, 2)``."""
+        """``(geom_matid (B, n), geom_quat (B, 4), in_view (B, n))`` of the sprite geoms in worlds where
+        each geom's animation began ``ages`` ``(B, n)`` int tics ago, the camera at ``eye_xy``
+        ``(B, 2)`` heading ``yaw`` ``(B,)``, the geoms at ``sprite_xy`` ``(B, n, 2)``.
+
+        ``in_view``: whether a geom's picture may show in the frame; one that is
+        False lies wholly behind the eye or beside the view's wedge, so drawing it
+        or not gives the same frame (a GL renderer saves its draw).
+        """
         xp = self._xp
         half = yaw / 2
         zero = xp.zeros_like(half)
         quat = xp.stack([xp.cos(half), zero, zero, xp.sin(half)], axis=-1)  # turned to the camera's heading
         offset = sprite_xy - eye_xy[:, None, :]
-        depth = offset[..., 0] * xp.cos(yaw)[:, None] + offset[..., 1] * xp.sin(yaw)[:, None]
+        cos, sin = xp.cos(yaw)[:, None], xp.sin(yaw)[:, None]
+        depth = offset[..., 0] * cos + offset[..., 1] * sin
+        across = offset[..., 0] * sin - offset[..., 1] * cos  # to the right
+        # The picture spans its depth's plane within its reach of the spot; the view's wedge
+        # there spans +-depth * _VIEW_TANGENT.
+        in_view = (depth + self._reach > 0) & (xp.abs(across) - self._reach < (depth + self._reach) * _VIEW_TANGENT)
         depth_bin = xp.searchsorted(self._bin_edges, xp.astype(depth, self._bin_edges.dtype))
         index = self._first + (xp.astype(ages, xp.int64) % self._cycle) * self._bins + depth_bin
-        return xp.reshape(xp.take(self._materials, xp.reshape(index, (-1,)), axis=0), index.shape), quat
+        return xp.reshape(xp.take(self._materials, xp.reshape(index, (-1,)), axis=0), index.shape), quat, in_view
 
 
 def tint(xp, frames, rgb, alpha):
@@ -316,7 +343,7 @@ class FramePipeline:
     def scene(self, state: dict, xy, yaw, bob, sprite_xy) -> dict:
         """What to draw per world: ``eye_dz`` ``(B,)`` (metres over the eye's height; head-bob),
         ``pistol`` ``(dx, dy)`` ``(B,)`` int pixels, and with sprites ``sprite_material`` ``(B, n)``
-        and ``sprite_quat`` ``(B, 4)`` (:class:`SpriteView`, its ``geom_ids``).
+        and ``sprite_quat`` ``(B, 4)``, ``sprite_in_view`` ``(B, n)`` (:class:`SpriteView`, its ``geom_ids``).
 
         ``state``: the rules' state of the batch; ``xy`` ``(B, 2)`` and ``yaw``
         ``(B,)``: the agents' poses; ``bob`` ``(B,)``: Doom's walking bob of their last tic;
@@ -336,7 +363,8 @@ class FramePipeline:
             clock = core.FIRST_OBSERVATION_TIC + state["steps"] * core.TICS_PER_STEP
             objects = self._sprite_objects
             ages = clock[:, None] - xp.take(state["animation_start"], objects, axis=1)
-            scene["sprite_material"], scene["sprite_quat"] = self.sprites(ages, xy, yaw, sprite_xy)
+            scene["sprite_material"], scene["sprite_quat"], scene["sprite_in_view"] = self.sprites(
+                ages, xy, yaw, sprite_xy)
         return scene
 
     def finish(self, frames, inverse_depth, eye, yaw, state: dict, scene: dict):

@@ -5,6 +5,8 @@ The expected colours were measured in ViZDoom with ``python tools/doom_frames.py
 these tests hold them, so they run without ViZDoom.
 """
 
+import math
+
 import mujoco
 import numpy as np
 import pytest
@@ -481,3 +483,34 @@ def test_the_flat_style_draws_no_pistol_and_maps_no_ceiling():
     assert len(floor) > 0.3 * len(image)
     top_down.close()
     env.task.close()
+
+
+@pytest.mark.parametrize("ahead", [False, True])
+def test_a_sprite_out_of_view_is_left_out_of_the_render_and_the_frame_is_the_same(ahead, monkeypatch):
+    # Llvmpipe pays for every picture sent, so the CPU renderer leaves out the
+    # sprites wholly behind the eye or beside the view: the frame must be the one
+    # that drawing them gives, and the model must show them again after (maps and
+    # segmentation render the same model).
+    env = stone_room_with(sprites.GREEN_ARMOUR)
+    physics, task = env.physics, env.task
+    geom = physics.object_ids(["item_0"])[1][0]
+    physics.place_objects(geom, np.array([[0.5, 0.5]]))
+    place(env, 1.5, 0.5, math.pi if ahead else 0.0)  # the item 1 m ahead, or 1 m behind
+    left_out = []
+    hide = type(task)._leave_out_unseen
+
+    def watching(self, scene, row):
+        shown = hide(self, scene, row)
+        left_out.append(shown is not None and physics.model.geom_group[geom] == render.HIDDEN_GROUP)
+        return shown
+
+    monkeypatch.setattr(type(task), "_leave_out_unseen", watching)
+    frame = task.get_observation(physics)["pixels"].copy()
+    assert left_out == [not ahead]
+    assert physics.model.geom_group[geom] == mjcf.VISIBLE_GROUP
+    monkeypatch.setattr(type(task), "_leave_out_unseen", lambda self, scene, row: None)
+    drawn = task.get_observation(physics)["pixels"]
+    seen = (task.segmentation(physics) == geom).sum()
+    task.close()
+    assert np.array_equal(frame, drawn)
+    assert (seen > 0) == ahead  # ahead, the item is in the frame

@@ -196,6 +196,19 @@ class MazeTask(core.MazeRules, base.Task):
             self._model.geom_matid[self._sprite_ids] = scene["sprite_material"][row]
             self._model.geom_quat[self._sprite_ids] = scene["sprite_quat"][row]
 
+    def _leave_out_unseen(self, scene: dict, row: int) -> np.ndarray | None:
+        """Hides the sprites outside the view (row ``row`` of the scene) for the next render; returns
+        the sprites' groups to put back after it (None: none hidden). Llvmpipe pays for every
+        picture sent, seen or not: Two-colour's ~25 items cost ~90 us a frame."""
+        if self._sprite_ids is None:
+            return None
+        unseen = ~scene["sprite_in_view"][row]
+        if not unseen.any():
+            return None
+        groups = self._model.geom_group[self._sprite_ids]
+        self._model.geom_group[self._sprite_ids[unseen]] = render.HIDDEN_GROUP
+        return groups
+
     def _frame_buffers(self, envs: int) -> tuple[np.ndarray, np.ndarray | None]:
         """GL's colour and depth buffers for ``envs`` frames (bottom-up rows), kept between calls."""
         if self._buffers is None or len(self._buffers[0]) != envs:
@@ -269,7 +282,10 @@ def observe(tasks: Sequence[MazeTask], physics: Sequence[MazePhysics], out: np.n
     rgb, depth = first._frame_buffers(len(tasks))
     for row, task in enumerate(tasks):
         task._set_view(scene, row)
+        shown = task._leave_out_unseen(scene, row)
         task._renderer.render_into(task._bound_data, rgb[row], None if depth is None else depth[row])
+        if shown is not None:
+            task._model.geom_group[task._sprite_ids] = shown
     inverse_depth = None if depth is None else first._renderer.inverse_depth(depth[:, ::-1])
     eye = np.concatenate([pose[:, :2], mjcf.EYE_HEIGHT + np.asarray(scene["eye_dz"])[:, None]], axis=1)
     out[...] = pipeline.finish(rgb[:, ::-1], inverse_depth, eye, pose[:, 2], state, scene)
