@@ -32,8 +32,8 @@ VISUAL_STYLES = ("textured", "flat")
 #: corners (with 1 m quads the floor under the eye flashed 2.5x brighter each
 #: time the agent passed a corner; 0.5 m cost ~30 us of a frame on llvmpipe).
 #: Since Doom's light (mjmaze.look) GL lights evenly; larger quads (1, 2,
-#: 20 m) stepped no faster within the noise (docs/speed.md) and moved a few
-#: pixels in a million, so they stay.
+#: 20 m) stepped no faster within the noise and moved a few pixels in a
+#: million, so they stay (CHANGELOG.md, "Speed measurements").
 LIT_QUAD = 0.5
 MAP_UNIT = 1 / 128  # metres per Doom map unit (a 128-unit cell is 1 m)
 EGO_CAMERA = "ego"  # the agent's eye (xml_templates/arena.xml)
