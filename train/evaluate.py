@@ -24,7 +24,7 @@ import torch
 from tqdm import tqdm
 
 from mjmaze import files, registry, suite
-from mjmaze.vector import MazeVectorEnv
+from mjmaze.vector import MazeVectorEnv, make_vector_env
 
 from . import checkpoint, policy
 from .model import Agent
@@ -52,14 +52,16 @@ def check_sizes(num_envs: int, num_configs: int | None = None, plays_per_config:
 
 def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, device: torch.device, seed: int = 0,
                num_configs: int | None = None, progress: bool = True, layouts: str | None = None,
-               plays_per_config: int = PLAYS_PER_CONFIG) -> dict:
+               plays_per_config: int = PLAYS_PER_CONFIG, backend: str = "cpu") -> dict:
     """Plays each of the first ``num_configs`` (default ``EVAL_CONFIGS``) configurations of ``split``
     ``plays_per_config`` times (default twice).
 
     Actions are the argmax of ``agent``'s policy, or uniformly random ones
     for ``agent=None``. ``seed`` seeds the envs (the episodes' random draws:
     spawn headings, items) and the random actions. ``layouts``: a folder of
-    released mazes to play instead of the split's generated ones.
+    released mazes to play instead of the split's generated ones. ``backend``:
+    ``"cpu"`` (:class:`~mjmaze.vector.MazeVectorEnv`) or ``"warp"`` (every env in one
+    MuJoCo Warp model on ``device``: :class:`mjmaze.warp.MazeBatchEnv`).
     """
     num_configs = check_sizes(num_envs, num_configs, plays_per_config)
     # Env i starts at configuration i * 64 / num_envs and cycles, so its first
@@ -69,10 +71,15 @@ def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, devic
     task_kwargs = {k: v for k, v in args.task_kwargs().items() if k != "num_configs"}
     if layouts is not None:
         task_kwargs["layouts"] = layouts
-    envs = MazeVectorEnv(
-        num_envs, args.scenario, autoreset_mode="same_step", copy=False, split=split,
-        num_configs=num_configs, config_sampling="cycle", **task_kwargs,
-    )
+    if backend == "cpu":
+        envs = MazeVectorEnv(
+            num_envs, args.scenario, autoreset_mode="same_step", copy=False, split=split,
+            num_configs=num_configs, config_sampling="cycle", **task_kwargs,
+        )
+    else:  # the ended episodes' last frames are not needed: no second render on their step
+        envs = make_vector_env(num_envs, args.scenario, backend=backend, device=str(device), autoreset_mode="same_step",
+                               keep_final_obs=False, split=split, num_configs=num_configs, config_sampling="cycle",
+                               **task_kwargs)
     metric, scale, _ = suite.paper_metric(args.scenario)
     declared = registry.get(args.scenario)
     random_actions = np.random.default_rng(seed)
@@ -89,11 +96,11 @@ def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, devic
                 actions = random_actions.integers(envs.single_action_space.n, size=num_envs)
             else:
                 with torch.no_grad():
-                    features = agent.features(torch.from_numpy(obs).to(device))
+                    features = agent.features(torch.as_tensor(obs).to(device))
                     logits, _, hidden = agent.step(features, hidden, starts.to(device))
                 actions = logits.argmax(-1).cpu().numpy()
             obs, _, terminated, truncated, infos = envs.step(actions)
-            ended = terminated | truncated
+            ended = np.asarray(torch.as_tensor(terminated | truncated).cpu())
             starts = torch.from_numpy(ended)
             steps += 1
             for i in np.flatnonzero(ended):
