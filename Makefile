@@ -86,8 +86,11 @@ $(VENV)/.stamp-triton: $(VENV)/.stamp-torch
 	  echo "Installing $(TRITON), as PyPI's torch would"; $(PY) -m pip install -q "$(TRITON)"; fi
 	@touch $@
 
+# On every editable install of a package that maps folders (train/ as mjmaze.train),
+# setuptools warns that folders named like the package may shadow it: information,
+# and noise in `make run`'s output. Its warnings are UserWarnings; errors still fail.
 $(VENV)/.stamp-%: pyproject.toml | $(VENV)/bin/python
-	$(PY) -m pip install -q -e ".[$*]"
+	PYTHONWARNINGS=ignore::UserWarning $(PY) -m pip install -q -e ".[$*]"
 	@touch $@
 
 clean:

@@ -164,3 +164,19 @@ def test_tools_given_a_folder_that_is_no_run_say_so(tmp_path):
     for tool in (curves.main, analysis.main):
         with pytest.raises(SystemExit, match="no config.json"):
             tool([str(tmp_path)])
+
+
+def test_a_curve_starts_where_the_first_episodes_can_reach_the_time_limit(tmp_path):
+    # Before 525 steps per env only the episodes that ended early have ended (a
+    # Labyrinth run's successes): their mean is not the agent's success, so the
+    # curve leaves those updates out rather than start at 100%.
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "config.json").write_text(json.dumps({"scenario": "labyrinth", "size": 5, "num_envs": 2}))
+    first_limit = 525 * 2
+    records = [{"step": step, "success": 100.0} for step in range(100, first_limit, 100)]  # in %, as a2c writes it
+    records += [{"step": step, "success": 20.0} for step in range(first_limit, 5 * first_limit, 100)]
+    (run / "metrics.jsonl").write_text("\n".join(json.dumps(r) for r in records))
+    curve = curves.binned([curves.read_run(run)], bins=10)
+    assert curve["step"] and min(curve["step"]) >= first_limit / 2  # no bin left of the first limit's
+    assert curve["mean"] == pytest.approx([20.0] * len(curve["mean"]))  # the early 100s gone

@@ -361,4 +361,15 @@ def test_the_main_job_trains_evaluates_beside_chance_draws_films_and_says_so(tmp
     printed = capsys.readouterr().out.strip().splitlines()[-3:]
     assert printed == summary["lines"]
     assert printed[0].startswith("trained: A2C on mjmaze/Labyrinth-v12 size 5, 64 agent steps")
-    assert "a random policy: train" in printed[1] and str(run / "curve.png") in printed[2]
+    # 64 steps teach nothing: the summary says so, and evaluates sampled actions too.
+    assert printed[1].startswith("not learned yet: success % on the test mazes greedy ")
+    assert ", sampled " in printed[1] and "a random policy" in printed[1] and (run / "eval_sampled.json").exists()
+    assert summary["learned"] is False and str(run / "curve.png") in printed[2]
+
+
+def test_the_main_job_calls_an_agent_learned_at_60_percent_and_three_times_chance():
+    from mjmaze.train import first_run
+
+    assert first_run.learned(60.0, 20.0)
+    assert not first_run.learned(59.0, 10.0)  # under 60%
+    assert not first_run.learned(90.0, 31.0)  # under 3x a random policy's

@@ -7,7 +7,9 @@ Runs with the same scenario and difficulty (config.json) are seeds of one curve
 and share a panel. Solid: the training episodes' value from ``metrics.jsonl``
 (sampled actions, training mazes) in the units of the paper's training curves
 (the metric; for K-item the return over its most), averaged in ``--bins`` step
-bins. Black squares: the paper's own curve at that difficulty, read off its
+bins from the step at which the first episodes can reach the time limit (before
+it only the episodes that ended early have ended: a Labyrinth run's curve would
+start at its few quick successes). Black squares: the paper's own curve at that difficulty, read off its
 released plots (``mjmaze.registry.Scenario.paper_curves``). With
 ``--evaluate`` (or where a run already has them), greedy evaluations of each
 kept checkpoint on the training and test configurations (``mjmaze.train.evaluate``,
@@ -25,7 +27,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from tqdm import tqdm
 
-from mjmaze import files, registry
+from mjmaze import core, files, registry
 
 from . import checkpoint, evaluate, paper_agents
 from .analysis import save_figure
@@ -97,16 +99,24 @@ def label(config: dict) -> str:
     return setting(config) + (f" (no {', no '.join(missing)})" if missing else "")
 
 
+def first_time_limit(config: dict) -> int:
+    """The training step at which a run's first episodes can reach the time limit: before it, only
+    the episodes that ended early (Labyrinth's successes) have ended, and their mean is no curve."""
+    return core.EPISODE_STEPS * int(config.get("num_envs", 1))
+
+
 def binned(runs: list[dict], bins: int) -> dict:
-    """The training metric of ``runs`` on one grid of step bins: mean and std over runs."""
+    """The training metric of ``runs`` on one grid of step bins: mean and std over runs, from each
+    run's first time limit on (:func:`first_time_limit`)."""
     last = max((r["steps"].max() for r in runs if len(r["steps"])), default=0)
     if last == 0:
         return {"step": [], "mean": [], "std": [], "seeds": 0}
     edges = np.linspace(0, last, bins + 1)
     per_run = []
     for r in runs:
-        which = np.clip(np.searchsorted(edges, r["steps"], side="left") - 1, 0, bins - 1)
-        sums = np.bincount(which, weights=r["values"], minlength=bins)
+        kept = r["steps"] >= first_time_limit(r["config"])
+        which = np.clip(np.searchsorted(edges, r["steps"][kept], side="left") - 1, 0, bins - 1)
+        sums = np.bincount(which, weights=r["values"][kept], minlength=bins)
         counts = np.bincount(which, minlength=bins)
         per_run.append(np.where(counts > 0, sums / np.maximum(counts, 1), np.nan))
     per_run = np.array(per_run)

@@ -52,12 +52,12 @@ def check_sizes(num_envs: int, num_configs: int | None = None, plays_per_config:
 
 def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, device: torch.device, seed: int = 0,
                num_configs: int | None = None, progress: bool = True, layouts: str | None = None,
-               plays_per_config: int = PLAYS_PER_CONFIG, backend: str = "cpu") -> dict:
+               plays_per_config: int = PLAYS_PER_CONFIG, backend: str = "cpu", sampled: bool = False) -> dict:
     """Plays each of the first ``num_configs`` (default ``EVAL_CONFIGS``) configurations of ``split``
     ``plays_per_config`` times (default twice).
 
-    Actions are the argmax of ``agent``'s policy, or uniformly random ones
-    for ``agent=None``. ``seed`` seeds the envs (the episodes' random draws:
+    Actions are the argmax of ``agent``'s policy (with ``sampled``: drawn from
+    it, as in training), or uniformly random ones for ``agent=None``. ``seed`` seeds the envs (the episodes' random draws:
     spawn headings, items) and the random actions. ``layouts``: a folder of
     released mazes to play instead of the split's generated ones. ``backend``:
     ``"cpu"`` (:class:`~mjmaze.vector.MazeVectorEnv`) or ``"warp"`` (every env in one
@@ -83,6 +83,7 @@ def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, devic
     metric, scale, _ = suite.paper_metric(args.scenario)
     declared = registry.get(args.scenario)
     random_actions = np.random.default_rng(seed)
+    draws = torch.Generator(device=device).manual_seed(seed)  # sampled actions
     episodes: list[list[dict]] = [[] for _ in range(num_envs)]
     steps = np.zeros(num_envs, dtype=np.int64)  # of each env's current episode
     bar = tqdm(total=num_envs * per_env, desc=f"{split} episodes", unit="ep", leave=False,
@@ -98,7 +99,10 @@ def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, devic
                 with torch.no_grad():
                     features = agent.features(torch.as_tensor(obs).to(device))
                     logits, _, hidden = agent.step(features, hidden, starts.to(device))
-                actions = logits.argmax(-1).cpu().numpy()
+                if sampled:
+                    actions = torch.multinomial(torch.softmax(logits, -1), 1, generator=draws).squeeze(1).cpu().numpy()
+                else:
+                    actions = logits.argmax(-1).cpu().numpy()
             obs, _, terminated, truncated, infos = envs.step(actions)
             ended = np.asarray(torch.as_tensor(terminated | truncated).cpu())
             starts = torch.from_numpy(ended)
@@ -124,7 +128,7 @@ def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, devic
         # In the units of the paper's training curves (the metric but for K-item's normalised return).
         "curve_value": float(np.mean([e[declared.curve_field] for e in played])) * declared.curve_scale,
         "configs": sorted(e["config_index"] for e in played),
-        "seed": seed, "plays_per_config": plays_per_config,
+        "seed": seed, "plays_per_config": plays_per_config, "actions": "sampled" if sampled else "greedy",
         # Each episode's (configuration, metric in the table's units, agent steps): paper_table's intervals.
         "per_episode": sorted((e["config_index"], float(e[metric]) * scale, e["length"]) for e in played),
     }
@@ -151,8 +155,9 @@ def evaluate_random(args: Args, num_envs: int = 16, out: str | pathlib.Path | No
 def evaluate(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | None = None, num_envs: int = 16,
              device: str = "auto", out: str | pathlib.Path | None = None, num_configs: int | None = None,
              torch_threads: int | None = INFERENCE_THREADS, progress: bool = True,
-             plays_per_config: int = PLAYS_PER_CONFIG, seed: int = 0) -> dict:
-    """Evaluates a run's checkpoint (default: its latest) on train and test.
+             plays_per_config: int = PLAYS_PER_CONFIG, seed: int = 0, sampled: bool = False) -> dict:
+    """Evaluates a run's checkpoint (default: its latest) on train and test (greedy; ``sampled``: actions
+    drawn from the policy, as in training).
 
     ``num_configs`` configurations per split (default ``EVAL_CONFIGS`` = 64),
     each played ``plays_per_config`` times, the envs seeded with ``seed``.
@@ -163,11 +168,11 @@ def evaluate(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | 
     torch_device = pick_device(device)
     with using_torch_threads(torch_threads):
         return _evaluate(run_dir, checkpoint_path, num_envs, torch_device, out, num_configs, progress,
-                         plays_per_config, seed)
+                         plays_per_config, seed, sampled)
 
 
 def _evaluate(run_dir, checkpoint_path, num_envs, torch_device, out, num_configs, progress, plays_per_config,
-              seed) -> dict:
+              seed, sampled=False) -> dict:
     args, agent, state = policy.load_run(run_dir, checkpoint_path, torch_device)
     result = {
         "run": str(run_dir),
@@ -185,7 +190,8 @@ def _evaluate(run_dir, checkpoint_path, num_envs, torch_device, out, num_configs
         result["released_mazes"] = layouts
     for split in ("train", "test"):
         result[split] = play_split(agent, args, split, num_envs, torch_device, seed=seed, num_configs=num_configs,
-                                   progress=progress, layouts=layouts.get(split), plays_per_config=plays_per_config)
+                                   progress=progress, layouts=layouts.get(split), plays_per_config=plays_per_config,
+                                   sampled=sampled)
     files.atomic_write_json(pathlib.Path(out) if out else default_output(run_dir), result)
     return result
 

@@ -38,6 +38,16 @@ SCENARIO, SIZE = "labyrinth", 5
 DEFAULT_STEPS = 1_000_000
 VIDEO_EPISODES = 2
 
+#: What "learned" means in the summary: success on the test mazes at least this (%) and this many
+#: times a random policy's, evaluated the same way.
+LEARNED_SUCCESS, LEARNED_OVER_CHANCE = 60.0, 3.0
+
+
+def learned(success: float, chance: float) -> bool:
+    """Whether an agent whose test success is ``success`` (%) has learned, beside a random policy's ``chance``."""
+    return success >= LEARNED_SUCCESS and success >= LEARNED_OVER_CHANCE * chance
+
+
 def main_job(total_steps: int = DEFAULT_STEPS, run_name: str | None = None, runs_dir: str = "runs",
              paper: bool = False, seed: int = 0, eval_configs: int | None = None, eval_envs: int = 16,
              video_steps: int | None = None) -> dict:
@@ -55,10 +65,16 @@ def main_job(total_steps: int = DEFAULT_STEPS, run_name: str | None = None, runs
     run_dir = a2c.train(args)
     minutes = (time.monotonic() - started) / 60
 
-    print("evaluating the agent and a random policy (greedy; 64 train + 64 test mazes, each twice)")
+    print("evaluating the agent (greedy) and a random policy: 64 train + 64 test mazes, each twice")
     agent = evaluate.evaluate(run_dir, num_envs=eval_envs, num_configs=eval_configs)
     chance = evaluate.evaluate_random(dataclasses.replace(args, run_name=None), num_envs=eval_envs,
                                       num_configs=eval_configs, out=run_dir / "eval_random.json")
+    sampled = None
+    if not learned(agent["test"]["value"], chance["test"]["value"]):
+        # An argmax policy can turn on the spot where sampling, as in training, walks on.
+        print("greedy lags: evaluating the agent with sampled actions too")
+        sampled = evaluate.evaluate(run_dir, num_envs=eval_envs, num_configs=eval_configs, sampled=True,
+                                    out=run_dir / "eval_sampled.json")
 
     units = registry.get(SCENARIO).metric_units
     groups = curves.curves([run_dir])
@@ -73,16 +89,20 @@ def main_job(total_steps: int = DEFAULT_STEPS, run_name: str | None = None, runs
     policy.policy_arguments(playing)  # the flags record's command line takes
     video = record.record(playing.parse_args([str(run_dir), "--split", "test", "--seed", str(seed)]),
                           VIDEO_EPISODES, run_dir / "episodes.mp4", max_steps=video_steps)
+    best = max(agent["test"]["value"], sampled["test"]["value"] if sampled else 0.0)
+    verdict = "learned" if learned(best, chance["test"]["value"]) else "not learned yet"
     summary = {
         "run": str(run_dir), "env_id": agent["env_id"], "total_steps": agent["step"], "minutes_training": minutes,
         "units": units, "agent": {s: agent[s]["value"] for s in ("train", "test")},
         "random": {s: chance[s]["value"] for s in ("train", "test")},
-        "curve": str(curve_png), "video": video["video"],
+        "sampled": {s: sampled[s]["value"] for s in ("train", "test")} if sampled else None,
+        "learned": verdict == "learned", "curve": str(curve_png), "video": video["video"],
     }
+    sampled_text = f", sampled {sampled['test']['value']:.1f}" if sampled else ""
     lines = [
         f"trained: A2C on {agent['env_id']} size {SIZE}, {agent['step']:,} agent steps in {minutes:.1f} min -> {run_dir}",
-        f"greedy {units}: train {agent['train']['value']:.1f}, test {agent['test']['value']:.1f} "
-        f"(a random policy: train {chance['train']['value']:.1f}, test {chance['test']['value']:.1f})",
+        f"{verdict}: {units} on the test mazes greedy {agent['test']['value']:.1f}{sampled_text}, a random policy "
+        f"{chance['test']['value']:.1f} (train: {agent['train']['value']:.1f} / {chance['train']['value']:.1f})",
         f"pictures: {curve_png}, {video['video']}",
     ]
     summary["lines"] = lines
