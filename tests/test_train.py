@@ -351,7 +351,7 @@ def test_workers_that_keep_dying_end_in_a_checkpoint_and_one_line(tmp_path, monk
 def test_the_main_job_trains_evaluates_beside_chance_draws_films_and_says_so(tmp_path, monkeypatch, capsys):
     from mjmaze.train import first_run
 
-    monkeypatch.setattr(first_run, "QUICK", {"num_envs": 4, "num_steps": 8})
+    monkeypatch.setattr(first_run, "CONFIGURATION", {"num_envs": 4, "num_steps": 8})
     summary = first_run.main_job(total_steps=64, run_name="first", runs_dir=str(tmp_path), eval_configs=2,
                                  eval_envs=2, video_steps=5)
     run = tmp_path / "first"
