@@ -22,9 +22,9 @@ TRITON ?= triton==3.7.1
 # CUDA build). Without an NVIDIA GPU: TORCH_INDEX=https://download.pytorch.org/whl/cpu
 TORCH_INDEX ?=
 # The main job (mjmaze.train.first_run): A2C on Labyrinth 5x5 with the paper's
-# configuration, ~12 minutes of training on 2 CPU cores, then a greedy evaluation
+# configuration, ~14 minutes of training on 2 CPU cores, then a greedy evaluation
 # beside a random policy, a learning curve and a video.
-RUN_STEPS ?= 1300000
+RUN_STEPS ?= 1100000
 RUN_ARGS ?=
 
 .PHONY: run test test-fast bench setup system-deps test-deps clean
