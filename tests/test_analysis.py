@@ -133,9 +133,10 @@ def test_tsne_keeps_at_most_the_asked_number_of_states(tmp_path):
 
 @pytest.mark.slow
 def test_learning_curves_average_seeds_with_train_and_test_evaluations(tmp_path, monkeypatch):
-    # Random agents die within ~100 steps in Two-colour: training episodes end in a tiny run.
+    # Random agents die within ~100 steps in Two-colour: training episodes end in a small run, which
+    # goes past the first time limit (525 steps per env), where the curve starts.
     runs = [tiny_run(tmp_path, f"tc_s{seed}", scenario="two_colour", size=None, complexity=3, seed=seed,
-                     total_steps=320, checkpoint_every=160) for seed in (0, 1)]
+                     total_steps=1280, checkpoint_every=640) for seed in (0, 1)]
     other = tiny_run(tmp_path, "lab", keep_checkpoints=1)
     monkeypatch.setattr(evaluate, "EVAL_CONFIGS", 4)
     out = tmp_path / "curves.png"
@@ -145,13 +146,13 @@ def test_learning_curves_average_seeds_with_train_and_test_evaluations(tmp_path,
     two_colour = groups[0]
     assert two_colour["training"]["seeds"] == 2 and two_colour["training"]["step"]
     assert all(0 < v <= 2100 for v in two_colour["training"]["mean"])
-    assert two_colour["evaluations"]["step"] == [160, 320] and two_colour["evaluations"]["seeds"] == [2, 2]
+    assert two_colour["evaluations"]["step"] == [640, 1280] and two_colour["evaluations"]["seeds"] == [2, 2]
     assert all(0 < v <= 2100 for v in two_colour["evaluations"]["test_mean"])
     # The paper's own curve at complexity 3 is drawn beside ours (Labyrinth 5 is not in the paper).
     assert two_colour["paper"]["step"][:2] == [2_500_000, 5_000_000] and two_colour["paper"]["value"][0] == 430
     assert groups[1]["paper"]["step"] == []
     for run in runs:
-        assert sorted(p.name for p in (run / "evals").iterdir()) == ["step_000000000160.json", "step_000000000320.json"]
+        assert sorted(p.name for p in (run / "evals").iterdir()) == ["step_000000000640.json", "step_000000001280.json"]
     picture(out)
     # Variants of one setting (not seeds): a curve per run, named by its folder.
     curves.main([*map(str, runs), "--each-run", "--out", str(out)])
