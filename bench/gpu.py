@@ -64,9 +64,12 @@ def wheels() -> list[str]:
     return pinned
 
 
-def _warp_bench():
-    """bench/warp.py as a module (its name would shadow the ``warp`` package)."""
-    spec = importlib.util.spec_from_file_location("warp_bench", _HERE / "warp.py")
+def _sibling(name: str):
+    """bench/<name>.py as a module, its own folder's imports found after the installed packages'
+    (bench/warp.py must not stand in for ``warp``)."""
+    if str(_HERE) not in sys.path:
+        sys.path.append(str(_HERE))
+    spec = importlib.util.spec_from_file_location(f"{name}_bench", _HERE / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
@@ -134,7 +137,7 @@ def frames(device: str, quick: bool) -> dict:
 
 def env_speed(device: str, quick: bool) -> dict:
     """MazeBatchEnv obs/s, rendering on and off, launches per step and memory per world (bench/warp.py)."""
-    bench = _warp_bench()
+    bench = _sibling("warp")
     worlds_list, seconds = ((4, 8), 1.0) if quick else ((256, 1024, 4096, 8192), 4.0)
     results = {}
     for scenario, kwargs in SETTINGS:
@@ -157,7 +160,7 @@ def env_speed(device: str, quick: bool) -> dict:
 
 def training(device: str, quick: bool) -> dict:
     """A2C training obs/s on the Warp backend (bench/warp.py's ``bench_training``)."""
-    bench = _warp_bench()
+    bench = _sibling("warp")
     results = {}
     for worlds, updates in (((8, 3),) if quick else ((1024, 12), (4096, 8))):
         rate = bench.bench_training(worlds, device, updates)
@@ -167,27 +170,15 @@ def training(device: str, quick: bool) -> dict:
 
 
 def cpu_backend(quick: bool) -> dict:
-    """The CPU backend: MazeVectorEnv with one process per core (EGL on NVIDIA's driver where there is one)."""
-    import numpy as np
-
+    """The CPU backend: MazeVectorEnv with one process per core (EGL on NVIDIA's driver where there is one),
+    as bench/multiproc.py measures it (Two-colour at its default complexity, 3)."""
     from mjmaze import render
-    from mjmaze.vector import MazeVectorEnv
 
     cores = len(os.sched_getaffinity(0))
     num_envs, seconds = (4, 1.0) if quick else (8 * cores, 10.0)
     results = {}
     for scenario, kwargs in SETTINGS:
-        envs = MazeVectorEnv(num_envs, scenario, copy=False, **kwargs)
-        rng = np.random.default_rng(0)
-        envs.reset(seed=0)
-        for _ in range(5):
-            envs.step(rng.integers(5, size=num_envs))
-        steps, start = 0, time.perf_counter()
-        while time.perf_counter() - start < seconds:
-            envs.step(rng.integers(5, size=num_envs))
-            steps += 1
-        rate = steps * num_envs / (time.perf_counter() - start)
-        envs.close()
+        rate, _ = _sibling("multiproc").bench_vector(num_envs, kwargs.get("size"), seconds, scenario=scenario)
         results[scenario] = {"obs_per_second": rate, "num_envs": num_envs, "cores": cores}
         print(f"  cpu    {scenario:<11} {num_envs} envs on {cores} cores ({render.choose_backend()}): "
               f"{rate:10.0f} obs/s", flush=True)
