@@ -24,7 +24,7 @@ its figures then mean nothing. Sections (``--only`` picks some):
 
 The released agents come from ``--paper-dir`` (or MJMAZE_PAPER_DIR; the
 machine may be offline). What the machine lacks comes as wheels:
-``../shared/device/pack-wheels $(python bench/gpu.py --wheels)`` (docs/warp_backend.md).
+``../shared/device/pack-wheels $(python bench/gpu.py --wheels)`` (docs/notes/warp_backend.md, "Measuring on a GPU").
 """
 
 from __future__ import annotations

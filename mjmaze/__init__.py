@@ -3,7 +3,7 @@
 Two front doors::
 
     env = mjmaze.load("labyrinth", task_kwargs={"size": 9})          # dm_control
-    env = gymnasium.make("mjmaze/Labyrinth-v12", size=9)               # gymnasium
+    env = gymnasium.make(mjmaze.GYM_IDS["labyrinth"], size=9)       # gymnasium
 
 Importing mjmaze picks no GL backend: see :mod:`mjmaze.render` (``MUJOCO_GL``).
 """

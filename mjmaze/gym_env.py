@@ -14,7 +14,7 @@ from mjmaze.tasks import base
 class MazeEnv(gym.Env):
     """A mjmaze scenario through the gymnasium API.
 
-    ``gymnasium.make("mjmaze/Labyrinth-v12", size=9, split="train")`` builds one;
+    ``gymnasium.make(mjmaze.GYM_IDS["labyrinth"], size=9, split="train")`` builds one;
     keyword arguments are the scenario's task arguments (see
     ``mjmaze.task_kwarg_names``). ``terminated`` marks a task end (exit
     reached, ...), ``truncated`` the 525-step limit. ``info`` carries the

@@ -38,7 +38,7 @@ STONE_ROOM = Room(wall=(0.33, 0.33, 0.33), floor=(0.52, 0.40, 0.19), ceiling=(0.
 #: Two-colour: ``STONE2`` walls (grey), ``NUKAGE1`` floor (green slime), ``CEIL4_1`` ceiling.
 #: The walls are every scenario's ``STONE2``: the released generator writes each
 #: side with it and replaces the base map's ``GSTONE1`` (green-grey) walls, which
-#: mjmaze drew until ``TwoColour-v2`` (docs/paper_agents.md). The ceiling is
+#: mjmaze drew until ``TwoColour-v2`` (docs/notes/paper_agents.md, item 8). The ceiling is
 #: the paper's Freedoom 0.10.1 ``CEIL4_1`` (blue 9 in ViZDoom's top rows);
 #: until ``TwoColour-v10`` it was 0.13's, twice as bright (blue 17).
 SLIME_ROOM = Room(wall=STONE_ROOM.wall, floor=(0.20, 0.40, 0.13), ceiling=(0.0, 0.0, 0.035),

@@ -26,7 +26,8 @@ class Scenario:
       name: what :func:`mjmaze.load` takes, e.g. ``"labyrinth"``.
       task: the scenario's class: a :class:`mjmaze.core.MazeRules` subclass (or, as before,
         a :class:`mjmaze.tasks.base.MazeTask` subclass).
-      gym_id: the gymnasium id, e.g. ``"mjmaze/Labyrinth-v12"``.
+      gym_id: the gymnasium id, e.g. ``"mjmaze/Labyrinth-v0"`` (the built-in
+        scenarios' current ids come from :mod:`mjmaze.versions`).
       seed_code: an integer that enters every maze seed of the scenario. Fixed
         forever: changing it changes every published configuration. Distinct
         across scenarios.

@@ -2,7 +2,7 @@
 
 The paper's ViZDoom (1.1.4) drew Freedoom 0.10.1; its items are small
 pictures, not one colour, and the released agents tell them apart by their
-detail (docs/paper_agents.md: the K-item 4 agent took the right first item
+detail (docs/notes/paper_agents.md: the K-item 4 agent took the right first item
 2 times in 64 with one-colour stand-ins, 62 with these pictures).
 
 ``freedoom/pictures.wad`` holds those pictures unchanged, in Doom's own patch

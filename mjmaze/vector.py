@@ -10,7 +10,7 @@ Every process has one GL context for all its envs (faster than one per env: see
 
 Reached the standard way::
 
-    envs = gymnasium.make_vec("mjmaze/Labyrinth-v12", num_envs=16,
+    envs = gymnasium.make_vec(mjmaze.GYM_IDS["labyrinth"], num_envs=16,
                               vectorization_mode="vector_entry_point", size=9)
 
 Autoreset follows gymnasium 1.x: ``autoreset_mode="next_step"`` (the default,
@@ -101,8 +101,9 @@ def _write_info(columns: dict[str, np.ndarray], slot: int, info: dict) -> None:
 class _EnvGroup:
     """The envs one process steps (a worker's share, or the calling process's).
 
-    The lean path: :meth:`mjmaze.tasks.base.MazeTask.advance` and a render
-    straight into the env's slot of the shared observations, results written
+    The lean path: each env's tics, then the rules once for the group's shared
+    state rows and one :func:`mjmaze.tasks.base.observe` for the group, drawn
+    straight into the envs' slots of the shared observations, results written
     into the shared columns; no ``TimeStep`` or observation dict per step.
     Autoreset is done here, as the module docstring describes.
     """

@@ -4,7 +4,7 @@
 gymnasium vector env whose observations, rewards, flags and ``info`` are torch
 tensors on ``device``; reached from the registry by one word::
 
-    envs = gymnasium.make_vec("mjmaze/Labyrinth-v12", num_envs=4096,
+    envs = gymnasium.make_vec(mjmaze.GYM_IDS["labyrinth"], num_envs=4096,
                               vectorization_mode="vector_entry_point", backend="warp", size=9)
 
 It plays the same task as the CPU envs: the same configurations (splits,

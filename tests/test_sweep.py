@@ -101,8 +101,8 @@ def test_a_tiny_grid_survives_a_kill_resumes_without_redoing_and_reports(tmp_pat
     assert 0 < float(row["test_mean"]) <= 2100 and row["paper_test_mean"] == "1941"
     text = (tmp_path / "tiny" / "report.md").read_text()
     assert "| 1 | 2 | " in text and "1941 ± 4" in text
-    assert "trained on `mjmaze/TwoColour-v13`" in text and row["env_ids"] == "mjmaze/TwoColour-v13"
-    assert json.loads((second / "eval.json").read_text())["trained_env_id"] == "mjmaze/TwoColour-v13"
+    assert f"trained on `{mjmaze.GYM_IDS['two_colour']}`" in text and row["env_ids"] == mjmaze.GYM_IDS["two_colour"]
+    assert json.loads((second / "eval.json").read_text())["trained_env_id"] == mjmaze.GYM_IDS["two_colour"]
     assert (tmp_path / "tiny" / "curves_two_colour.png").stat().st_size > 1000
 
 

@@ -8,6 +8,8 @@ import re
 import pytest
 import torch
 
+import mjmaze
+
 from mjmaze.train import settings as run_settings
 from mjmaze.train import a2c, checkpoint, evaluate, policy
 from mjmaze.train.model import Agent
@@ -100,7 +102,7 @@ def test_two_update_smoke_run_writes_a_run_folder(tmp_path):
     run = a2c.train(tiny(tmp_path, total_steps=32))
     config = json.loads((run / "config.json").read_text())
     assert config["size"] == 5
-    assert config["env_id"] == "mjmaze/Labyrinth-v12"  # the version the run trained on
+    assert config["env_id"] == mjmaze.GYM_IDS["labyrinth"]  # the version the run trained on
     lines = [json.loads(line) for line in (run / "metrics.jsonl").read_text().splitlines()]
     assert [line["step"] for line in lines] == [16, 32]
     assert all(math.isfinite(line["policy_loss"]) and line["sps"] > 0 for line in lines)
@@ -355,12 +357,12 @@ def test_the_main_job_trains_evaluates_beside_chance_draws_films_and_says_so(tmp
     summary = first_run.main_job(total_steps=64, run_name="first", runs_dir=str(tmp_path), eval_configs=2,
                                  eval_envs=2, video_steps=5)
     run = tmp_path / "first"
-    assert json.loads((run / "config.json").read_text())["env_id"] == summary["env_id"] == "mjmaze/Labyrinth-v12"
+    assert json.loads((run / "config.json").read_text())["env_id"] == summary["env_id"] == mjmaze.GYM_IDS["labyrinth"]
     assert (run / "eval.json").exists() and (run / "eval_random.json").exists()
     assert (run / "curve.png").stat().st_size > 1000 and pathlib.Path(summary["video"]).stat().st_size > 1000
     printed = capsys.readouterr().out.strip().splitlines()[-3:]
     assert printed == summary["lines"]
-    assert printed[0].startswith("trained: A2C on mjmaze/Labyrinth-v12 size 5, 64 agent steps")
+    assert printed[0].startswith(f"trained: A2C on {mjmaze.GYM_IDS['labyrinth']} size 5, 64 agent steps")
     # 64 steps teach nothing: the summary says so, and evaluates sampled actions too.
     assert printed[1].startswith("not learned yet: success % on the test mazes greedy ")
     assert ", sampled " in printed[1] and "a random policy" in printed[1] and (run / "eval_sampled.json").exists()

@@ -8,6 +8,8 @@ import gymnasium
 import numpy as np
 import pytest
 
+import mjmaze
+
 from mjmaze.vector import SHARED_MEMORY_PREFIX, MazeVectorEnv, WorkerError
 
 TURN_LEFT = 0
@@ -25,7 +27,7 @@ def no_leaked_segments():
 
 
 def test_make_vec_returns_the_shared_memory_vector_env():
-    envs = gymnasium.make_vec("mjmaze/Labyrinth-v12", num_envs=4, vectorization_mode="vector_entry_point", size=5)
+    envs = gymnasium.make_vec(mjmaze.GYM_IDS["labyrinth"], num_envs=4, vectorization_mode="vector_entry_point", size=5)
     assert isinstance(envs, MazeVectorEnv)
     assert envs.observation_space.shape == (4, 64, 112, 3)
     assert envs.action_space == gymnasium.spaces.MultiDiscrete([5] * 4)

@@ -257,7 +257,7 @@ def test_a_restarted_world_plays_the_cpu_envs_next_episode(scenario, mode, by_in
 
 def test_reached_through_gymnasium_by_one_word():
     envs = gymnasium.make_vec(
-        "mjmaze/KItem-v11", num_envs=3, vectorization_mode="vector_entry_point", backend="warp", device="cpu",
+        mjmaze.GYM_IDS["k_item"], num_envs=3, vectorization_mode="vector_entry_point", backend="warp", device="cpu",
         num_items=2, render=False,
     )
     assert isinstance(envs, mjwarp.MazeBatchEnv) and envs.single_action_space.n == 5
@@ -265,7 +265,7 @@ def test_reached_through_gymnasium_by_one_word():
     assert set(suite.make_task("k_item", {"num_items": 2}).info_fields()) <= set(info)
     envs.close()
     with pytest.raises(ValueError, match="backend"):
-        gymnasium.make_vec("mjmaze/KItem-v11", num_envs=2, vectorization_mode="vector_entry_point", backend="tpu")
+        gymnasium.make_vec(mjmaze.GYM_IDS["k_item"], num_envs=2, vectorization_mode="vector_entry_point", backend="tpu")
 
 
 def test_bad_arguments_say_what_to_do():

@@ -17,45 +17,15 @@ Arguments
 Metric
     ``success``: target found and return reached; ``target_found``.
 Version History
-    * v8 (2026-11-27): the floor's flat laid as Doom lays flats: a 64-unit
-      tile every half metre (v7 drew it twice as large), columns along x and
-      rows along -y from the map's origin; the ceiling shows ``MFLR8_1`` the same
-      way, where it was one colour (docs/look.md, "Rooms").
-    * v7 (2026-11-27): the walls and floor show Freedoom 0.10.1's own textures,
-      the released maps' ``STONE2`` and ``FLAT1_1`` (their grey pattern in the
-      room's calibrated colours), laid as Doom lays them (docs/look.md, "Rooms").
-    * v6 (2026-11-27): the released mazes' geometry and Doom's squares: inner
-      walls end at their grid lines, the outer wall's face is the maze's
-      edge; the agent and pillars block as squares aligned with the map and
-      items are touched within 0.28 m in x and y, as Doom tests things; the
-      tic the agent meets a wall it keeps only the rest of its move
-      (docs/motion.md, "Walls and squares").
-    * v5 (2026-11-27): the agent slides along walls as Doom
-      does: a tic a wall or a pillar stops it, it keeps 31/32 of the slid
-      velocity (Doom's slide move), so it slides at 74% of the speed
-      before (docs/motion.md, "Along walls").
-    * v4 (2026-11-26): things (exits, items, pillars, totems) lit as Doom
-      lights sprites: by the sector's light over depth, between the two
-      walls' curves (``palette.THING_LIGHT``); before, the old lamp's curve,
-      8-22% brighter within 2 m, as bright beyond 3 m (docs/look.md, "Light").
-    * v3 (2026-11-26): Doom's light: every pixel lit by its depth along the
-      view axis, walls running east-west darker than walls running
-      north-south, floor and ceiling by their own curves, all measured in
-      ViZDoom (``tools/doom_frames.py --light``); before, a lamp at the eye
-      lit surfaces by its angle and distance (docs/look.md, "Light").
-    * v2 (2026-11-26): Doom's projection: pixels 1.2x as tall as wide (a
-      vertical focal length 1.2x the horizontal, as ViZDoom draws the released
-      frames), so walls and things stand 1.2x as tall in the frame as in the
-      earlier versions' square pixels (docs/look.md, "Projection").
-    * v1 (2026-11-25): no pistol drawn: the released maps' ENTER scripts clear
-      the inventory, so ViZDoom never drew one (found with the paper's agents).
-    * v0 (2026-11-23): initial release; frames, motion and rules calibrated
-      against ViZDoom through 2026-11-24 under the same id (CHANGELOG.md).
+    (from :mod:`mjmaze.versions`, newest first)
 """
 
 from __future__ import annotations
 
-from mjmaze import configs, core, maze, mjcf, palette, registry, rules
+from mjmaze import configs, core, maze, mjcf, palette, registry, rules, versions
+
+if __doc__:  # python -OO drops docstrings
+    __doc__ += versions.version_history(versions.FIND_RETURN)
 
 
 SIZES = (5, 7, 9, 11, 13)
@@ -127,7 +97,7 @@ class FindReturn(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="find_return",
     task=FindReturn,
-    gym_id="mjmaze/FindReturn-v8",
+    gym_id=versions.gym_id(versions.FIND_RETURN),
     seed_code=2,
     difficulty="size",
     difficulties=SIZES,

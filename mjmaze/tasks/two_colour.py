@@ -17,7 +17,7 @@ Rules
     totem's colour gives +25; the other colour takes 25 less what the armour
     just picked up absorbs: 17 for a green item, 13 for a red one.
     **Decision**: the released decay and damage, where the paper's spec reads 1
-    per agent step and 25 (README, "Decisions"); each hit flashes the view red
+    per agent step and 25 (docs/scenarios.md, "Decisions"); each hit flashes the view red
     (:func:`mjmaze.rules.flash`), every item gold.
 Rewards
     +0.01 per tic survived (+0.04 per agent step) and ``correct_item_reward``
@@ -37,74 +37,17 @@ Arguments
 Metric
     ``duration``: tics survived (max 2100); also ``health`` and ``totem_green``.
 Version History
-    * v13 (2026-11-27): 11 green and 10 red items at the start, the next
-      red at tic 30, as ViZDoom plays the released script (its timer's first
-      item, green, comes at tic 0; v12 started with 10 and 10 and spawned
-      green first at tic 30). Items blink as ViZDoom's observations show
-      them: each from its spawn on ViZDoom's episode clock (tic 1 at the
-      first observation), where v12 ran every animation on one clock from
-      tic 10: the red item is bright at one observation in three, not two
-      (docs/look.md, "Items"; docs/scenarios.md).
-    * v12 (2026-11-27): the floor's flat laid as Doom lays flats: a 64-unit
-      tile every half metre (v11 drew it twice as large), columns along x and
-      rows along -y from the map's origin; the ceiling shows ``CEIL4_1`` the same
-      way, where it was one colour (docs/look.md, "Rooms").
-    * v11 (2026-11-27): the walls and floor show Freedoom 0.10.1's own textures,
-      the released maps' ``STONE2`` and ``NUKAGE1`` (their grey pattern in the
-      room's calibrated colours), laid as Doom lays them (docs/look.md, "Rooms"); the
-      ceiling as the paper's Freedoom draws ``CEIL4_1``, half as bright.
-    * v10 (2026-11-27): items lit as Doom lights sprites: a sector-lit picture
-      through Doom's colormap at its depth (toward the palette's browns, not in
-      proportion), a fullbright one (the armours' blink) in its own colours at
-      any depth; a picture's rows below its origin drawn above the floor, whole;
-      the blue armour blinks 6 + 6 tics (docs/look.md, "Items").
-    * v9 (2026-11-27): the released mazes' geometry and Doom's squares: inner
-      walls end at their grid lines, the outer wall's face is the maze's
-      edge; the agent and the totem block as squares aligned with the map and
-      items are touched within 0.28 m in x and y, as Doom tests things; the
-      tic the agent meets a wall it keeps only the rest of its move
-      (docs/motion.md, "Walls and squares"); items appear where the released
-      script's Spawn succeeds, the armour's square clear of walls, totem and agent.
-    * v8 (2026-11-27): the agent slides along walls as Doom
-      does: a tic a wall or a pillar stops it, it keeps 31/32 of the slid
-      velocity (Doom's slide move), so it slides at 74% of the speed
-      before (docs/motion.md, "Along walls").
-    * v7 (2026-11-26): items drawn as Freedoom 0.10.1's own pictures of the
-      green and the "blue" (red) armour (the paper's game data), turning to
-      face the camera as Doom's sprites do, instead of cylinders in their
-      coloured parts' colours (docs/paper_agents.md, item 17).
-    * v6 (2026-11-26): items in their coloured parts' colours as ViZDoom
-      draws them averaged over the armours' blink, 2-3 m ahead under Doom's
-      light (green 8% darker, red 18% brighter; docs/paper_agents.md, item 15).
-    * v5 (2026-11-26): things (exits, items, pillars, totems) lit as Doom
-      lights sprites: by the sector's light over depth, between the two
-      walls' curves (``palette.THING_LIGHT``); before, the old lamp's curve,
-      8-22% brighter within 2 m, as bright beyond 3 m (docs/look.md, "Light").
-    * v4 (2026-11-26): Doom's light: every pixel lit by its depth along the
-      view axis, walls running east-west darker than walls running
-      north-south, floor and ceiling by their own curves, all measured in
-      ViZDoom (``tools/doom_frames.py --light``); before, a lamp at the eye
-      lit surfaces by its angle and distance (docs/look.md, "Light").
-    * v3 (2026-11-26): Doom's projection: pixels 1.2x as tall as wide (a
-      vertical focal length 1.2x the horizontal, as ViZDoom draws the released
-      frames), so walls and things stand 1.2x as tall in the frame as in the
-      earlier versions' square pixels (docs/look.md, "Projection").
-    * v2 (2026-11-25): grey ``STONE2`` walls, as the released generator writes
-      them (``-v1`` drew its base map's green-grey ``GSTONE1``); an imported
-      layout that spawns the agent on the totem's spot has no totem, as in
-      ViZDoom (it had one the agent started inside).
-    * v1 (2026-11-25): items in their sprites' coloured parts (the green chest,
-      the red body) instead of the whole sprites' mean colour; the released
-      agent survives 1,105 / 1,179 train / test tics, not 805 / 780 (ViZDoom: 1,485 / 1,400).
-    * v0 (2026-11-23): initial release; frames, motion and rules calibrated
-      against ViZDoom through 2026-11-24 under the same id (CHANGELOG.md).
+    (from :mod:`mjmaze.versions`, newest first)
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from mjmaze import configs, core, mjcf, palette, registry, rules, sprites, walls
+from mjmaze import configs, core, mjcf, palette, registry, rules, sprites, versions, walls
+
+if __doc__:  # python -OO drops docstrings
+    __doc__ += versions.version_history(versions.TWO_COLOUR)
 
 
 COMPLEXITIES = tuple(range(0, 11))
@@ -116,7 +59,7 @@ START_ITEMS_PER_COLOUR = 10
 SPAWN_EVERY_TICS = 30
 # The released script's 10 of each colour, then its timer's items every 30 tics from tic 0,
 # green first: 11 green and 10 red at the first observation, the next (red) at tic 30
-# (measured in ViZDoom: docs/scenarios.md, "Two-colour's items").
+# (measured in ViZDoom: docs/notes/scenarios.md, "Two-colour's items").
 START_ITEMS = 2 * START_ITEMS_PER_COLOUR + 1
 POOL_SIZE = START_ITEMS + (core.EPISODE_STEPS * core.TICS_PER_STEP) // SPAWN_EVERY_TICS  # 91
 MAX_HEALTH = 100
@@ -388,7 +331,7 @@ class TwoColour(core.MazeRules):
 SCENARIO = registry.Scenario(
     name="two_colour",
     task=TwoColour,
-    gym_id="mjmaze/TwoColour-v13",
+    gym_id=versions.gym_id(versions.TWO_COLOUR),
     seed_code=4,
     difficulty="complexity",
     difficulties=COMPLEXITIES,
