@@ -22,7 +22,7 @@ TRITON ?= triton==3.7.1
 # CUDA build). Without an NVIDIA GPU: TORCH_INDEX=https://download.pytorch.org/whl/cpu
 TORCH_INDEX ?=
 # The main job (mjmaze.train.first_run): A2C on Labyrinth 5x5 with the paper's
-# configuration, ~14 minutes of training on 2 CPU cores, then a greedy evaluation
+# configuration, ~13 minutes of training on 2 CPU cores, then a greedy evaluation
 # beside a random policy, a learning curve and a video.
 RUN_STEPS ?= 1100000
 RUN_ARGS ?=

@@ -1,4 +1,4 @@
-"""Per-step cost of Doom's flashes and of each scenario's rules: the vector env's per-env step.
+"""Per-step cost of Doom's flashes and of each scenario's rules: one env's step.
 
     python bench/flashes.py [--steps 2000] [--rounds 3] [--scenarios two_colour find_return k_item labyrinth]
 

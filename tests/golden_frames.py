@@ -36,8 +36,9 @@ STEPS = 120
 #: The steps whose frames are kept (0 is the reset's): Two-colour's scripts flash at 7, 14, 49 and 63
 #: (its damage every 8 steps, a pickup) and restart after 94 (env 1).
 KEPT = (0, 7, 14, 28, 49, 63, 84, 95, 112)
-# Actions 0-4: none, forward, back, turn left, turn right (mjmaze.core.ACTION_NAMES): mostly forward, so the
-# agent walks (head-bob), meets walls and reaches items.
+# Actions 0-4: turn left, turn right, forward, forward+left, forward+right (mjmaze.core.ACTION_NAMES): a
+# forward key 40% of the steps and turning right 55%, so the agent walks (head-bob), turns, meets walls and
+# reaches items. (Fixed with the reference frames: other weights would need a re-record.)
 _ACTION_WEIGHTS = (0.05, 0.55, 0.05, 0.175, 0.175)
 
 

@@ -1,6 +1,6 @@
 """The main job (``make run``): train an agent on Labyrinth 5x5, then show what it learned.
 
-    python -m mjmaze.train.first_run                         # ~14 minutes of training on 2 CPU cores
+    python -m mjmaze.train.first_run                         # ~13 minutes of training on 2 CPU cores
     python -m mjmaze.train.first_run --total-steps 2000000   # longer
 
 Four steps, each a tool a researcher can run alone: ``mjmaze.train.a2c``
