@@ -6,8 +6,8 @@ the ids it touches, as gymnasium does. This table is the one place those
 versions are written: the registry's ids (:func:`gym_id`, read by each
 scenario's ``SCENARIO`` declaration), each scenario's Version History (its
 module's docstring, ``help(mjmaze.tasks.labyrinth)``; :func:`version_history`)
-and CHANGELOG.md's id lines (:func:`changelog_lines`) are produced from it, and
-tests/test_versions.py holds them to it.
+and CHANGELOG.md's id lines (:func:`changelog_lines`; ``python tools/changelog_ids.py``
+prints them) are produced from it, and tests/test_versions.py holds them to it.
 
 The release discipline (docs/architecture.md, "Versions and releases"):
 changes that alter results accumulate on main under the next release, and
@@ -178,9 +178,3 @@ def changelog_lines(release: str) -> list[str]:
             lines.append(f"- {change.date}, {ids}: {change.change}.{measured}")
     return lines
 
-
-if __name__ == "__main__":  # python -m mjmaze.versions: the CHANGELOG lines of every release
-    for name, date in RELEASES:
-        print(f"## {name}" + (f" ({date})" if date else " (unreleased)"))
-        print("\n".join(changelog_lines(name)) or "(no change to any id yet)")
-        print()

@@ -74,7 +74,7 @@ def test_the_changelog_has_a_section_per_release_with_its_id_lines():
     for name, _ in versions.RELEASES:
         section = re.search(rf"^## {re.escape(name)} .*?(?=^## |\Z)", text, flags=re.M | re.S).group(0)
         for line in versions.changelog_lines(name):
-            assert line in section, f"CHANGELOG.md's {name} lacks: {line} (python -m mjmaze.versions prints them)"
+            assert line in section, f"CHANGELOG.md's {name} lacks: {line} (python tools/changelog_ids.py prints them)"
 
 
 def test_the_package_version_is_the_latest_release():
