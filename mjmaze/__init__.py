@@ -23,11 +23,11 @@ with warnings.catch_warnings():
     warnings.filterwarnings("ignore", module="glfw")
     from dm_control import mujoco as _dm_mujoco  # noqa: F401
 
-from mjmaze import registry  # noqa: E402
+from mjmaze import registry, versions  # noqa: E402
 from mjmaze.suite import ALL_TASKS, load, register, task_kwarg_names  # noqa: E402
 
 __all__ = ["ALL_TASKS", "GYM_IDS", "load", "register", "registry", "task_kwarg_names"]
-__version__ = "0.1.0"
+__version__ = versions.package_version()  # the latest release of the versions table (pyproject.toml says the same)
 
 #: scenario -> gymnasium id, for the scenarios that ship with mjmaze
 #: (``mjmaze.registry.get(name).gym_id`` for any registered one).
