@@ -3,7 +3,8 @@
     python bench/gpu.py [--device cuda] [--quick] [--out gpu.json] [--paper-dir DIR] [--only SECTION ...]
     python bench/gpu.py --wheels   # NAME==VERSION of what a GPU machine lacks, for pack-wheels
 
-Sized for ~8 minutes on one H100 or H200; ``--quick`` shrinks every section to
+Sized for ~10 minutes on one H100 or H200 (a first run on an H200 reached the
+second released agent at 545 s); ``--quick`` shrinks every section to
 check, on Warp's CPU device (``--device cpu``), that the script runs end to end:
 its figures then mean nothing. Sections (``--only`` picks some):
 
@@ -12,45 +13,49 @@ its figures then mean nothing. Sections (``--only`` picks some):
             difference (grey levels) and the share of pixels showing the same
             geom; tests/test_warp.py holds the mean under 8 (Warp's ray tracer
             filters textures where GL takes the nearest texel)
-  env       MazeBatchEnv obs/s, rendering on and off, at 256 .. 8,192 worlds,
+  env       MazeBatchEnv obs/s, rendering on and off, at 1,024 .. 8,192 worlds,
             Warp launches per step, device memory per world (bench/warp.py)
   train     A2C training obs/s, `python -m mjmaze.train.a2c --backend warp`,
             at 1,024 and 4,096 envs (bench/warp.py)
   cpu       the CPU backend (MazeVectorEnv) with one process per core, drawing
-            with EGL (on NVIDIA's driver where there is one), for comparison
+            with EGL (on NVIDIA's driver where there is one), beside the raw
+            loop and ViZDoom (bench/multiproc.py's sides, alternating); a
+            worker's time an env step against GL's draw alone; the golden
+            frames (recorded on llvmpipe) played on this GL
   paper     the paper's released agents (paper:labyrinth_9, paper:two_colour_1)
             on their 64 test mazes, twice each, on both backends: the Warp
             backend must score within 10% of the CPU one
 
 The released agents come from ``--paper-dir`` (or MJMAZE_PAPER_DIR; the
-machine may be offline). What the machine lacks comes as wheels:
-``../shared/device/pack-wheels $(python bench/gpu.py --wheels)`` (docs/notes/warp_backend.md, "Measuring on a GPU").
+machine may be offline). What the machine lacks, from ``--wheels``: docs/warp_backend.md, "Measuring on a GPU".
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib
 import importlib.metadata
 import importlib.util
 import json
-import os
 import pathlib
 import sys
 import time
+import traceback
 
 # Python puts this script's folder first on sys.path, where bench/warp.py would
-# stand in for the `warp` package that MuJoCo Warp imports.
+# stand in for the `warp` package that MuJoCo Warp imports: it goes last (the
+# processes bench/multiproc.py spawns run this again, and import it from there).
 _HERE = pathlib.Path(__file__).resolve().parent
-sys.path[:] = [entry for entry in sys.path if pathlib.Path(entry or ".").resolve() != _HERE]
+sys.path[:] = [entry for entry in sys.path if pathlib.Path(entry or ".").resolve() != _HERE] + [str(_HERE)]
 
 #: What mjmaze's Warp backend, its CPU twin and training need that the GPU machines' image lacks
 #: (it has torch, numpy, scipy, absl-py, lxml, protobuf, tensorboard, tqdm, rich, ...).
 GPU_WHEELS = ("mujoco", "mujoco-warp", "warp-lang", "dm-control", "labmaze", "dm-env", "dm-tree", "glfw",
               "PyOpenGL", "websockets", "gymnasium", "Farama-Notifications", "array-api-compat", "tyro",
-              "docstring-parser", "typeguard")
+              "docstring-parser", "typeguard", "vizdoom")
 SETTINGS = (("labyrinth", {"size": 9}), ("two_colour", {"complexity": 3}))
 PAPER_AGENTS = ("paper:labyrinth_9", "paper:two_colour_1")
-SECTIONS = ("frames", "env", "train", "cpu", "paper")
+SECTIONS = ("frames", "env", "cpu", "train", "paper")  # the order they run in: a run cut short keeps the first
 
 
 def wheels() -> list[str]:
@@ -67,9 +72,18 @@ def wheels() -> list[str]:
 def _sibling(name: str):
     """bench/<name>.py as a module, its own folder's imports found after the installed packages'
     (bench/warp.py must not stand in for ``warp``)."""
-    if str(_HERE) not in sys.path:
-        sys.path.append(str(_HERE))
-    spec = importlib.util.spec_from_file_location(f"{name}_bench", _HERE / f"{name}.py")
+    return _sibling_from(_HERE, name)
+
+
+def _sibling_from(folder: pathlib.Path, name: str):
+    """``folder/<name>.py`` as a module, ``folder`` searched after the installed packages: by its own name
+    (so that processes it spawns find its functions) unless an installed package has that name."""
+    if str(folder) not in sys.path:
+        sys.path.append(str(folder))
+    found = importlib.util.find_spec(name)
+    if found is not None and found.origin == str(folder / f"{name}.py"):
+        return importlib.import_module(name)
+    spec = importlib.util.spec_from_file_location(f"{name}_{folder.name}", folder / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
@@ -138,7 +152,7 @@ def frames(device: str, quick: bool) -> dict:
 def env_speed(device: str, quick: bool) -> dict:
     """MazeBatchEnv obs/s, rendering on and off, launches per step and memory per world (bench/warp.py)."""
     bench = _sibling("warp")
-    worlds_list, seconds = ((4, 8), 1.0) if quick else ((256, 1024, 4096, 8192), 4.0)
+    worlds_list, seconds = ((4, 8), 1.0) if quick else ((1024, 4096, 8192), 3.0)
     results = {}
     for scenario, kwargs in SETTINGS:
         for worlds in worlds_list:
@@ -150,11 +164,12 @@ def env_speed(device: str, quick: bool) -> dict:
                     row["launches"] = bench.launches_per_step(envs, actions)
                 envs.close()
                 del envs
-            row["kb_per_world"] = bench.memory_per_world(scenario, kwargs, worlds, device)
+            if worlds == worlds_list[-1]:  # a fresh process each: once per scenario, at the most worlds
+                row["kb_per_world"] = bench.memory_per_world(scenario, kwargs, worlds, device)
             results[f"{scenario}_{worlds}"] = row
+            memory = f", {row['kb_per_world']:9.1f} KB a world" if "kb_per_world" in row else ""
             print(f"  env    {scenario:<11} {worlds:5d} worlds: {row['render']:10.0f} obs/s rendering, "
-                  f"{row['no_render']:10.0f} without, {row['launches']:6.0f} launches a step, "
-                  f"{row['kb_per_world']:9.1f} KB a world", flush=True)
+                  f"{row['no_render']:10.0f} without, {row['launches']:6.0f} launches a step{memory}", flush=True)
     return results
 
 
@@ -169,19 +184,89 @@ def training(device: str, quick: bool) -> dict:
     return results
 
 
-def cpu_backend(quick: bool) -> dict:
-    """The CPU backend: MazeVectorEnv with one process per core (EGL on NVIDIA's driver where there is one),
-    as bench/multiproc.py measures it (Two-colour at its default complexity, 3)."""
+def _gl_renderer() -> str:
+    """The GL renderer of this process's context (``llvmpipe ...`` on Mesa's CPU rasteriser, the card's name on
+    NVIDIA's EGL), read with ``glGetString`` through libglvnd."""
+    import ctypes
+
     from mjmaze import render
 
-    cores = len(os.sched_getaffinity(0))
-    num_envs, seconds = (4, 1.0) if quick else (8 * cores, 10.0)
+    render.gl_context()
+    for library in ("libOpenGL.so.0", "libGL.so.1"):
+        try:
+            gl = ctypes.CDLL(library)
+        except OSError:
+            continue
+        gl.glGetString.restype = ctypes.c_char_p
+        gl.glGetString.argtypes = [ctypes.c_uint]
+        vendor, renderer = gl.glGetString(0x1F00), gl.glGetString(0x1F01)  # GL_VENDOR, GL_RENDERER
+        if renderer:
+            return f"{vendor.decode()} {renderer.decode()}"
+    return "unknown"
+
+
+def _golden_differences() -> dict:
+    """The golden frames (recorded on Mesa's llvmpipe) played with this machine's GL: per scenario, the largest
+    mean and largest pixel difference (grey levels) over the kept frames: how far a GPU's frames are from CPU's."""
+    import numpy as np
+
+    golden = _sibling_from(_HERE.parent / "tests", "golden_frames")
     results = {}
-    for scenario, kwargs in SETTINGS:
-        rate, _ = _sibling("multiproc").bench_vector(num_envs, kwargs.get("size"), seconds, scenario=scenario)
-        results[scenario] = {"obs_per_second": rate, "num_envs": num_envs, "cores": cores}
-        print(f"  cpu    {scenario:<11} {num_envs} envs on {cores} cores ({render.choose_backend()}): "
-              f"{rate:10.0f} obs/s", flush=True)
+    with np.load(golden.PATH) as recorded:
+        for scenario in golden.SETTINGS:
+            means, largest = [], []
+            for seed in golden.SEEDS:
+                difference = np.abs(golden.play(scenario, seed).astype(int) - recorded[golden.key(scenario, seed)])
+                means += [float(frame.mean()) for frame in difference]
+                largest.append(int(difference.max()))
+            results[scenario] = {"mean_difference": max(means), "largest_difference": max(largest)}
+    return results
+
+
+def cpu_backend(quick: bool) -> dict:
+    """The CPU backend with GL on this machine (EGL on the card where NVIDIA's driver is) beside ViZDoom, as
+    bench/multiproc.py compares them: MazeVectorEnv (16 envs, and 8 a core), the raw loop and ViZDoom's
+    my_way_home one process per core, sides alternating in rounds. Then the step split: a worker's busy time per
+    env step against GL's draw alone (bench/speed.py's render path, one process), and the golden frames' distance."""
+    import numpy as np
+
+    multiproc, speed = _sibling("multiproc"), _sibling("speed")
+    cores = multiproc.CORES
+    seconds, rounds, draws = (1.0, 1, 100) if quick else (4.0, 2, 2000)
+    vectors = {f"{scenario}_{n}": (scenario, n) for scenario, n in
+               (("labyrinth", 16), ("labyrinth", 8 * cores), ("two_colour", 8 * cores))}
+    sides = [*vectors, "raw"] + (["vizdoom"] if importlib.util.find_spec("vizdoom") else [])
+    rates: dict[str, list[float]] = {side: [] for side in sides}
+    busy: dict[str, list[float]] = {side: [] for side in vectors}
+    for round_ in range(rounds):
+        for side in sides if round_ % 2 == 0 else reversed(sides):
+            if side == "raw":
+                rates[side].append(multiproc.bench_processes(multiproc._raw_process, seconds))
+            elif side == "vizdoom":
+                rates[side].append(multiproc.bench_processes(multiproc._vizdoom_process, seconds))
+            else:
+                scenario, num_envs = vectors[side]
+                rate, timings = multiproc._vector_in_subprocess(None, seconds, scenario, num_envs)
+                rates[side].append(rate)
+                busy[side].append(timings["worker_busy"] * cores / num_envs)  # a process steps num_envs / cores
+    results: dict = {"cores": cores, "gl_renderer": _gl_renderer(), "rounds": rounds, "seconds": seconds}
+    results["obs_per_second"] = {side: float(np.median(values)) for side, values in rates.items()}
+    results["worker_busy_us_per_env_step"] = {side: float(np.median(values)) for side, values in busy.items()}
+    results["draw_us_per_frame"] = 1e6 / speed.bench_render(9, draws, "textured")
+    results["golden_frames"] = _golden_differences()
+    print(f"  cpu    GL: {results['gl_renderer']}, {cores} cores, {rounds} rounds x {seconds:.0f} s (median obs/s):",
+          flush=True)
+    for side, rate in results["obs_per_second"].items():
+        ratio = f" ({rate / results['obs_per_second']['vizdoom']:.2f}x ViZDoom)" if "vizdoom" in rates else ""
+        line = f"  cpu    {side:<16} {rate:10.0f} obs/s{ratio}"
+        if side in busy:
+            spent = results["worker_busy_us_per_env_step"][side]
+            line += f"; a process busy {spent:.0f} us an env step, {spent - results['draw_us_per_frame']:.0f} beside GL's draw"
+        print(line, flush=True)
+    print(f"  cpu    GL's draw alone (Labyrinth 9, one process): {results['draw_us_per_frame']:.0f} us a frame", flush=True)
+    for scenario, row in results["golden_frames"].items():
+        print(f"  cpu    golden frames {scenario:<11} here vs llvmpipe: mean difference up to "
+              f"{row['mean_difference']:.3f}, largest {row['largest_difference']}", flush=True)
     return results
 
 
@@ -236,8 +321,9 @@ def main() -> None:
         try:
             report["sections"][section] = runs[section]()
         except Exception as error:  # noqa: BLE001 - one section's failure must not lose the others' figures
-            report["sections"][section] = {"error": f"{type(error).__name__}: {error}"}
-            print(f"  {section}: failed: {type(error).__name__}: {error}", flush=True)
+            report["sections"][section] = {"error": f"{type(error).__name__}: {error}",
+                                           "traceback": traceback.format_exc()}
+            print(f"  {section}: failed: {traceback.format_exc()}", flush=True)
         report.setdefault("seconds", {})[section] = time.perf_counter() - started
         pathlib.Path(args.out).write_text(json.dumps(report, indent=1))  # after each section: a cut run keeps its figures
     print(f"wrote {args.out}")

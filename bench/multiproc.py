@@ -138,10 +138,11 @@ def main() -> None:
     parser.add_argument("--scenario", default="labyrinth",
                         help="the scenario of (a) and (e) (labyrinth: 9x9; others at their default difficulty)")
     parser.add_argument("--vector-only", type=float, default=None, help=argparse.SUPPRESS)  # one (a), as JSON
+    parser.add_argument("--num-envs", type=int, default=16, help=argparse.SUPPRESS)  # (a)'s, with --vector-only
     args = parser.parse_args()
     if args.vector_only is not None:
         timings: dict = {}
-        rate = bench_vector(16, *_setting(args.scenario), args.vector_only, timings, args.scenario)[0]
+        rate = bench_vector(args.num_envs, *_setting(args.scenario), args.vector_only, timings, args.scenario)[0]
         print(json.dumps({"rate": rate, "timings": timings}))
         return
     with baseline.checkout(args.baseline) if args.baseline else contextlib.nullcontext() as old:
@@ -155,10 +156,11 @@ def _setting(scenario: str) -> tuple[int | None, ...]:
     return (9,) if scenario == "labyrinth" else (None,)
 
 
-def _vector_in_subprocess(checkout, seconds: float, scenario: str) -> tuple[float, dict]:
+def _vector_in_subprocess(checkout, seconds: float, scenario: str, num_envs: int = 16) -> tuple[float, dict]:
     """(a) in a fresh process (this script with ``--vector-only``), with the mjmaze of ``checkout``
     (None: this one): both sides start alike, whatever this process has loaded (ViZDoom, GL)."""
-    result = subprocess.run([sys.executable, __file__, "--vector-only", str(seconds), "--scenario", scenario],
+    result = subprocess.run([sys.executable, __file__, "--vector-only", str(seconds), "--scenario", scenario,
+                             "--num-envs", str(num_envs)],
                             check=True, capture_output=True, text=True, env=baseline.environment(checkout))
     answer = json.loads(result.stdout.strip().splitlines()[-1])
     return answer["rate"], answer["timings"]
