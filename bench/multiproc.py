@@ -10,6 +10,8 @@ Prints, alternating the sides in rounds so machine drift hits all of them:
   (c) vizdoom  ViZDoom my_way_home.cfg, 160x120 RGB (its smallest), make_action(a, 4),
                one process per core (skipped with a note when vizdoom is absent)
   (e) with --baseline REV: (a) from that git revision (bench/baseline.py)
+  (g) with --no-draw: (a) with GL's draw left out (each renderer copies its first frame instead,
+               MJMAZE_SKIP_DRAW=1): everything beside GL's draw, what a GPU box's cores would do
 then the ratios mjmaze/raw and mjmaze/ViZDoom, (d) scaling: obs/s for sizes 5, 9,
 13 and for num_envs 1, 4, 16, 64, with peak RSS per worker and per env, and (f)
 every registered scenario at its default difficulty, 16 envs.
@@ -135,6 +137,7 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--no-scaling", action="store_true")
     parser.add_argument("--baseline", default=None, help="a git revision whose vector env to measure beside (e.g. HEAD~3)")
+    parser.add_argument("--no-draw", action="store_true", help="also (a) with GL's draw left out, and the same of --baseline")
     parser.add_argument("--scenario", default="labyrinth",
                         help="the scenario of (a) and (e) (labyrinth: 9x9; others at their default difficulty)")
     parser.add_argument("--vector-only", type=float, default=None, help=argparse.SUPPRESS)  # one (a), as JSON
@@ -156,12 +159,17 @@ def _setting(scenario: str) -> tuple[int | None, ...]:
     return (9,) if scenario == "labyrinth" else (None,)
 
 
-def _vector_in_subprocess(checkout, seconds: float, scenario: str, num_envs: int = 16) -> tuple[float, dict]:
+def _vector_in_subprocess(checkout, seconds: float, scenario: str, num_envs: int = 16,
+                          draw: bool = True) -> tuple[float, dict]:
     """(a) in a fresh process (this script with ``--vector-only``), with the mjmaze of ``checkout``
-    (None: this one): both sides start alike, whatever this process has loaded (ViZDoom, GL)."""
+    (None: this one): both sides start alike, whatever this process has loaded (ViZDoom, GL).
+    ``draw`` False: GL's draw left out (``MJMAZE_SKIP_DRAW=1``, which a checkout before it ignores)."""
+    environment = baseline.environment(checkout)
+    if not draw:
+        environment["MJMAZE_SKIP_DRAW"] = "1"
     result = subprocess.run([sys.executable, __file__, "--vector-only", str(seconds), "--scenario", scenario,
                              "--num-envs", str(num_envs)],
-                            check=True, capture_output=True, text=True, env=baseline.environment(checkout))
+                            check=True, capture_output=True, text=True, env=environment)
     answer = json.loads(result.stdout.strip().splitlines()[-1])
     return answer["rate"], answer["timings"]
 
@@ -179,6 +187,10 @@ def _compare(args, old) -> None:
         rates[f"vizdoom ({CORES} procs)"] = []
     if old is not None:
         rates[f"mjmaze {args.baseline}"] = []
+    if args.no_draw:
+        rates["mjmaze no draw"] = []
+        if old is not None:
+            rates[f"mjmaze {args.baseline} no draw"] = []
     phases: list[dict] = []
     for round_ in range(args.rounds):
         sides = list(rates)
@@ -192,7 +204,9 @@ def _compare(args, old) -> None:
             elif side.startswith("vizdoom"):
                 rates[side].append(bench_processes(_vizdoom_process, args.seconds))
             else:
-                rates[side].append(_vector_in_subprocess(old, args.seconds, args.scenario)[0])
+                checkout = None if side.startswith("mjmaze no draw") else old
+                rates[side].append(_vector_in_subprocess(checkout, args.seconds, args.scenario,
+                                                         draw=not side.endswith("no draw"))[0])
     median = {name: statistics.median(values) for name, values in rates.items()}
     print(f"{args.scenario} vs ViZDoom my_way_home, {CORES} cores, {args.rounds} rounds x {args.seconds:.0f} s (median, min-max)")
     for name, values in rates.items():
@@ -205,6 +219,9 @@ def _compare(args, old) -> None:
         print("  ViZDoom skipped: `pip install -e .[bench]` (the vizdoom package) to compare.")
     if old is not None:
         print(f"  ratio mjmaze / mjmaze {args.baseline} : {mjmaze_rate / median[f'mjmaze {args.baseline}']:.2f}")
+    for name, rate in median.items():  # core time an env step takes, messaging and waiting included
+        if name.startswith("mjmaze"):
+            print(f"  {name:<28}: {1e6 * CORES / rate:6.0f} us of a core per env step")
     step = {key: statistics.median(p[key] for p in phases) for key in phases[0]}
     envs_per_worker = 16 // CORES
     print(f"  mjmaze step by phase (us per step of 16 envs): step {step['step']:.0f} = this process stepping its "

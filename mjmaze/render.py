@@ -24,6 +24,8 @@ import numpy as np
 from mjmaze import mjcf
 
 BACKENDS = ("egl", "osmesa")
+#: Set to "1" for benchmarks only: GL draws each renderer's first frame, then none (see EgoRenderer).
+SKIP_DRAW_VARIABLE = "MJMAZE_SKIP_DRAW"
 DEBIAN_PACKAGES = {"egl": "libegl1 libgl1-mesa-dri", "osmesa": "libosmesa6"}
 
 # Geom groups: 0-2 drawn (mjcf.CEILING_GROUP, 2, left out of maps); 3 = collision shapes; 5 = hidden objects.
@@ -235,6 +237,10 @@ class EgoRenderer:
         self._near, self._near_over_far = near, near / far
         self._catmask = int(mujoco.mjtCatBit.mjCAT_ALL)
         self._offscreen = int(mujoco.mjtFramebuffer.mjFB_OFFSCREEN)
+        # SKIP_DRAW_VARIABLE=1: after its first frame, render_into copies that frame instead of GL's
+        # draw, so that a benchmark times everything beside the draw (bench/multiproc.py --no-draw).
+        self._skip_draw = os.environ.get(SKIP_DRAW_VARIABLE) == "1"
+        self._first_frame: tuple[np.ndarray, np.ndarray | None] | None = None
 
     def upload_mesh(self, mesh_id: int) -> None:
         """Re-sends a mesh whose vertices changed in the model."""
@@ -264,9 +270,16 @@ class EgoRenderer:
         mujoco.mj_kinematics(self._model, data)
         mujoco.mj_camlight(self._model, data)
         mujoco.mjv_updateScene(self._model, data, self._option, self._perturb, self._camera, self._catmask, self._scene)
+        if self._first_frame is not None:  # only with SKIP_DRAW_VARIABLE
+            rgb[...] = self._first_frame[0]
+            if depth is not None:
+                depth[...] = self._first_frame[1]
+            return
         mujoco.mjr_setBuffer(self._offscreen, self._context)
         mujoco.mjr_render(self._viewport, self._scene, self._context)
         mujoco.mjr_readPixels(rgb, depth, self._viewport, self._context)
+        if self._skip_draw:
+            self._first_frame = rgb.copy(), None if depth is None else depth.copy()
 
     def inverse_depth(self, depth: np.ndarray) -> np.ndarray:
         """1 / metres along the view axis of GL's depth buffer values ``depth`` (affine in them)."""
