@@ -2,9 +2,8 @@
 
     python bench/flashes.py [--steps 2000] [--rounds 3] [--scenarios two_colour find_return k_item labyrinth]
 
-For each scenario at its evidence setting, steps/s of ``MazeTask.advance`` (action ->
-physics -> rules) plus ``get_observation`` (render, flash, copy into a preallocated
-frame), random actions, with ``flashes=True`` and ``flashes=False``, alternating in
+For each scenario at its evidence setting, steps/s of an ``EnvGroup`` of one's step (action ->
+physics -> rules) plus its frame (render, flash, into a preallocated frame), random actions, with ``flashes=True`` and ``flashes=False``, alternating in
 rounds so machine drift hits both sides. ``--sides default`` passes no ``flashes``
 argument at all: run it from an older checkout to compare code versions side by side.
 Run it on idle cores (no training or test suite beside it).
@@ -19,6 +18,8 @@ import time
 import numpy as np
 
 import mjmaze
+from mjmaze.group import EnvGroup
+from mjmaze.tasks import base
 
 SETTINGS = {"two_colour": {"complexity": 1}, "find_return": {"size": 5}, "k_item": {"num_items": 2},
             "labyrinth": {"size": 7}}
@@ -26,18 +27,20 @@ SIDES = {"on": {"flashes": True}, "off": {"flashes": False}, "default": {}}
 
 
 def steps_per_second(scenario: str, side: str, steps: int) -> float:
-    env = mjmaze.load(scenario, task_kwargs={**SETTINGS[scenario], "random": 0, **SIDES[side]})
-    task, physics = env.task, env.physics
-    task.observation_buffer = np.zeros(env.observation_spec()["pixels"].shape, np.uint8)
-    env.reset()
-    actions = np.random.default_rng(0).integers(len(task.actions), size=steps)
+    rules = mjmaze.suite.make_rules(scenario, {**SETTINGS[scenario], **SIDES[side]})
+    group = EnvGroup(rules, base.make_physics(rules), [0])
+    frame = np.zeros((1, rules.height, rules.width, 3), np.uint8)
+    group.reset([0])
+    actions = np.random.default_rng(0).integers(len(rules.actions), size=(steps, 1))
     start = time.perf_counter()
     for action in actions:
-        _, terminated, truncated = task.advance(physics, action)
-        if terminated or truncated:
-            env.reset()
-        task.get_observation(physics)
-    return steps / (time.perf_counter() - start)
+        _, terminated, truncated = group.step(action, [0])
+        if terminated[0] or truncated[0]:
+            group.reset([0])
+        group.observe(frame, [0])
+    rate = steps / (time.perf_counter() - start)
+    group.close()
+    return rate
 
 
 def main() -> None:

@@ -128,7 +128,7 @@ def frames(device: str, quick: bool) -> dict:
                 if ended[i]:
                     env.reset()
                 else:
-                    env.task.advance(env.physics, int(action[i]))
+                    env.step(int(action[i]))
             ended = (terminated | truncated).cpu().numpy()
             if step % every:
                 continue

@@ -76,7 +76,7 @@ def _raw_process(barrier, seconds, size, results):
 
     env = mjmaze.load("labyrinth", task_kwargs={"size": size, "random": os.getpid()})
     env.reset()
-    model, data, renderer = env.physics.model.ptr, env.physics.data.ptr, env.task._renderer
+    model, data, renderer = env.physics.model.ptr, env.physics.data.ptr, env.task._group.renderers[0]
     task, physics = env.task, env.physics
     actions = np.random.default_rng(os.getpid()).integers(5, size=4096)
     barrier.wait()

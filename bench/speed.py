@@ -6,8 +6,8 @@ Prints obs/s for, alternating in rounds so machine drift hits every side, each
 in the default "textured" frames and in the "flat" ones:
   render      mjv_updateScene + mjr_render + mjr_readPixels alone (the agent moving)
   raw         the lean loop: random actions' velocities, mj_step(model, data, 4) + the render path
-  lean        the vector env's per-env step: MazeTask.advance (action -> physics -> rules), the
-              render into a preallocated frame and the info dict, no dm_control TimeStep
+  lean        the vector env's per-env step: an EnvGroup of one (action -> physics -> rules), the
+              render into a preallocated frame and the infos, no dm_control TimeStep
   dm_control  env.step(action) of mjmaze.load("labyrinth"): action -> physics -> rules -> observation copy
   gymnasium   env.step(action) of gymnasium.make("mjmaze/Labyrinth-vN") (through its default wrappers)
 and the ratios full step / raw, textured / flat, plus a per-phase split of the full step.
@@ -25,13 +25,15 @@ import numpy as np
 
 import mjmaze
 from mjmaze import mjcf, render
+from mjmaze.group import EnvGroup
+from mjmaze.tasks import base
 
 
 def _lean_setup(size: int, style: str):
     env = mjmaze.load("labyrinth", task_kwargs={"size": size, "random": 0, "visual_style": style})
     env.reset()
     model, data = env.physics.model.ptr, env.physics.data.ptr
-    return env, model, data, env.task._renderer
+    return env, model, data, env.task._group.renderers[0]
 
 
 def bench_render(size: int, steps: int, style: str) -> float:
@@ -65,20 +67,20 @@ def bench_raw(size: int, steps: int, style: str) -> float:
 
 
 def bench_lean(size: int, steps: int, style: str) -> float:
-    env = mjmaze.load("labyrinth", task_kwargs={"size": size, "random": 0, "visual_style": style})
-    task, physics = env.task, env.physics
-    task.observation_buffer = np.empty(task.observation_spec(physics)["pixels"].shape, np.uint8)
-    actions = np.random.default_rng(0).integers(5, size=steps)
-    env.reset()
+    rules = mjmaze.suite.make_rules("labyrinth", {"size": size, "visual_style": style})
+    group = EnvGroup(rules, base.make_physics(rules), [0])
+    frame = np.empty((1, rules.height, rules.width, 3), np.uint8)
+    actions = np.random.default_rng(0).integers(5, size=(steps, 1))
+    group.reset([0])
     start = time.perf_counter()
     for action in actions:
-        _, terminated, truncated = task.advance(physics, action)
-        task.get_observation(physics)
-        task.get_info(physics)
-        if terminated or truncated:
-            env.reset()
+        _, terminated, truncated = group.step(action, [0])
+        group.observe(frame, [0])
+        group.infos([0])
+        if terminated[0] or truncated[0]:
+            group.reset([0])
     rate = steps / (time.perf_counter() - start)
-    task.close()
+    group.close()
     return rate
 
 

@@ -319,7 +319,7 @@ class FramePipeline:
     the frames (:class:`DoomLight`) and draws the pistol and the flashes. Both
     take a batch of worlds and the rules' state (:class:`mjmaze.core.EpisodeState`)
     on numpy or torch (``xp``): a CPU process calls them once per step with
-    all its envs (:func:`mjmaze.tasks.base.observe`), the MuJoCo Warp backend with
+    all its envs (:meth:`mjmaze.group.EnvGroup.observe`), the MuJoCo Warp backend with
     every world (:mod:`mjmaze.warp`). Made once per model and device.
     """
 

@@ -30,7 +30,6 @@ memory.
 from __future__ import annotations
 
 import contextlib
-import math
 import multiprocessing as mp
 import multiprocessing.connection
 import os
@@ -47,7 +46,9 @@ import numpy as np
 from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode
 
-from mjmaze import batch, core, registry, suite
+from mjmaze import batch, registry, suite
+from mjmaze.group import EnvGroup
+from mjmaze.rules import seed_key
 from mjmaze.tasks import base
 
 SHARED_MEMORY_PREFIX = "mjmaze_"
@@ -93,19 +94,14 @@ def _attach(name: str) -> shared_memory.SharedMemory:
     return shared_memory.SharedMemory(name=name)
 
 
-def _write_info(columns: dict[str, np.ndarray], slot: int, info: dict) -> None:
-    for key, value in info.items():
-        columns[key][slot] = value
+class _SharedGroup:
+    """The envs one process steps (a worker's share, or the calling process's): an
+    :class:`mjmaze.group.EnvGroup` and its slots of the shared arrays.
 
-
-class _EnvGroup:
-    """The envs one process steps (a worker's share, or the calling process's).
-
-    The lean path: each env's tics, then the rules once for the group's shared
-    state rows and one :func:`mjmaze.tasks.base.observe` for the group, drawn
-    straight into the envs' slots of the shared observations, results written
-    into the shared columns; no ``TimeStep`` or observation dict per step.
-    Autoreset is done here, as the module docstring describes.
+    A step runs the group's tics, rules and frames once, drawn straight into the
+    envs' slots of the shared observations, results written into the shared
+    columns; no ``TimeStep`` or observation dict. Autoreset is done here, as the
+    module docstring describes.
     """
 
     def __init__(self, arrays: dict[str, np.ndarray], slots: list[int], first_configs: list[int], scenario: str,
@@ -117,101 +113,77 @@ class _EnvGroup:
         if same_step:
             self._final_obs = arrays["final_obs"]
             self._final_columns = {name: arrays["final_scalars"][name] for name in scalars.dtype.names}
-        self._envs = []
-        self._ended = [False] * len(slots)  # next-step mode: the env resets on its next step
-        self._state: dict[str, np.ndarray] | None = None  # the group's rule state (see reset)
-        for slot, first in zip(slots, first_configs):
-            env = suite.load(scenario, {**task_kwargs, "first_config": first})
-            env.task.observation_buffer = self._obs[slot]
-            self._envs.append((slot, env, env.task, env.physics))
+        self._slots = np.array(slots)
+        rules = suite.make_rules(scenario, task_kwargs)
+        # Unseeded envs draw their keys as a dm_control task with random=None does.
+        keys = [seed_key(np.random.RandomState()) for _ in slots]
+        self._group = EnvGroup(rules, base.make_physics(rules, len(slots)), keys, first_configs)
+        self._ended = np.zeros(len(slots), dtype=bool)  # next-step mode: the env resets on its next step
 
     def reset(self, seeds: list[int] | None) -> None:
-        for i, (slot, env, task, _) in enumerate(self._envs):
-            if seeds is not None:
-                task.reseed(seeds[slot])
-            self._restart(i, slot, env)
-        if self._state is None:
-            # From now on the group's envs keep their rule state in one set of
-            # arrays, a row each, and the rules run once per step for all of them.
-            tasks = [task for _, _, task, _ in self._envs]
-            self._state = {name: np.concatenate([t.state[name] for t in tasks]) for name in tasks[0].state}
-            for row, task in enumerate(tasks):
-                task.share_state(self._state, row)
-            self._paths = np.zeros((len(tasks), base.TICS_PER_STEP, 2))
-            self._rules = tasks[0]  # every env's task is the same scenario core (mjmaze.core.MazeRules)
-            self._tasks, self._physics = tasks, [physics for _, _, _, physics in self._envs]
+        group = self._group
+        if seeds is not None:
+            for row, slot in enumerate(self._slots):
+                group.reseed(row, seed_key(np.random.RandomState(seeds[slot])))
+        self._restart(list(range(len(group))))
 
-    def _restart(self, i: int, slot: int, env) -> None:
-        env.reset()  # renders the first frame into the env's slot
-        self._ended[i] = False
-        columns = self._columns
-        columns["reward"][slot] = 0.0
-        columns["terminated"][slot] = columns["truncated"][slot] = False
-        _write_info(columns, slot, env.task.get_info(env.physics))
+    def _restart(self, rows: list[int]) -> None:
+        """New episodes in ``rows``: their first frames and infos, reward 0, both flags false."""
+        group, columns = self._group, self._columns
+        group.reset(rows)
+        self._ended[rows] = False
+        slots = self._slots[rows]
+        self._observe(rows, slots)
+        columns["reward"][slots] = 0.0
+        columns["terminated"][slots] = columns["truncated"][slots] = False
+        self._write_infos(columns, rows, slots)
+
+    def _observe(self, rows: list[int], slots: np.ndarray) -> None:
+        """The frames of ``rows`` into their slots (the group's slots are consecutive)."""
+        if len(rows) == len(self._slots):
+            self._group.observe(self._obs[slots[0] : slots[-1] + 1], rows)
+        else:
+            frames = np.empty((len(rows), *self._obs.shape[1:]), dtype=np.uint8)
+            self._group.observe(frames, rows)
+            self._obs[slots] = frames
 
     def step(self) -> None:
-        columns, actions, paths = self._columns, self._actions, self._paths
-        envs = self._envs
-        playing = [i for i in range(len(envs)) if not self._ended[i]]
-        # Each env's tics on its own: physics.batch_tics over the group measured slower
-        # (706 against 682 us per env step, a group of 8; 337 against 67 us for one env).
-        for i in playing:
-            slot, _, task, physics = envs[i]
-            task.before_step(actions[slot], physics)
-            physics.step(base.TICS_PER_STEP)
-            paths[i] = physics.tic_xy
-        # The rules for every env of the group at once. An env about to restart
-        # (its episode ended on the last step) goes through them too, on its
-        # old state, which its restart then replaces.
-        rewards, terminated, truncated = self._rules.step_state(np, self._state, paths)
-        for i in range(len(envs)):
-            if self._ended[i]:  # the step after an episode's end: its action is ignored
-                self._restart(i, envs[i][0], envs[i][1])
+        columns, group = self._columns, self._group
+        ended = np.flatnonzero(self._ended).tolist()
+        playing = np.flatnonzero(~self._ended).tolist()
+        actions = self._actions[self._slots]
+        # An env about to restart (its episode ended on the last step) goes through the rules
+        # too, on its old state, which its restart then replaces; its action is ignored.
+        rewards, terminated, truncated = group.step(actions, playing)
+        if ended:
+            self._restart(ended)
         if not playing:
             return
-        for i in playing:
-            _, _, task, physics = envs[i]
-            task.finish_step(physics, float(rewards[i]), bool(terminated[i]))
-        # Every playing env's frame at once, into its slot (the group's slots are consecutive).
-        slots = [envs[i][0] for i in playing]
-        if len(playing) == len(envs):
-            base.observe(self._tasks, self._physics, self._obs[slots[0] : slots[-1] + 1])
-        else:
-            frames = np.empty((len(playing), *self._obs.shape[1:]), dtype=np.uint8)
-            base.observe([envs[i][2] for i in playing], [envs[i][3] for i in playing], frames)
-            self._obs[slots] = frames
+        slots = self._slots[playing]
+        self._observe(playing, slots)
         columns["reward"][slots] = rewards[playing]
         columns["terminated"][slots] = terminated[playing]
         columns["truncated"][slots] = truncated[playing]
-        self._write_infos(columns, playing)
-        for i in playing:
-            if terminated[i] or truncated[i]:
-                if not self._same_step:
-                    self._ended[i] = True
-                    continue
-                slot, env, task, physics = envs[i]
-                self._final_obs[slot] = self._obs[slot]
-                _write_info(self._final_columns, slot, task.get_info(physics))
-                env.reset()
-                _write_info(columns, slot, task.get_info(physics))
+        self._write_infos(columns, playing, slots)
+        done = [row for row in playing if terminated[row] or truncated[row]]
+        if not done:
+            return
+        if not self._same_step:
+            self._ended[done] = True
+            return
+        done_slots = self._slots[done]
+        self._final_obs[done_slots] = self._obs[done_slots]
+        self._write_infos(self._final_columns, done, done_slots)
+        group.reset(done)
+        self._observe(done, done_slots)
+        self._write_infos(columns, done, done_slots)
 
-    def _write_infos(self, columns: dict[str, np.ndarray], playing: list[int]) -> None:
-        """The ``info`` fields of the envs ``playing`` (indices into the group), from the group's state at once."""
-        envs, state = self._envs, self._state
-        pose = np.array([envs[i][3].data.qpos[:3] for i in playing])
-        yaw = [math.remainder(value, math.tau) for value in pose[:, 2]]  # as MazePhysics.agent_pose
-        metrics = {name: value[playing] for name, value in self._rules.episode_metrics(state).items()}
-        fields = core.episode_info(metrics, pose[:, 0], pose[:, 1], yaw, state["steps"][playing],
-                                   state["episode_return"][playing], [envs[i][2].config.index for i in playing])
-        slots = [envs[i][0] for i in playing]
-        for name, value in fields.items():
+    def _write_infos(self, columns: dict[str, np.ndarray], rows: list[int], slots: np.ndarray) -> None:
+        for name, value in self._group.infos(rows).items():
             columns[name][slots] = value
 
     def close(self) -> None:
-        for _, _, task, _ in self._envs:
-            task.observation_buffer = None
-            task.close()
-        self._envs = []
+        self._group.close()
 
 
 def make_vector_env(num_envs: int, scenario: str = suite.DEFAULT_SCENARIO, backend: str = "cpu", **kwargs: Any):
@@ -264,7 +236,7 @@ def _worker(worker_id, conn, shm_name, layout, env_ids, first_configs, scenario,
     group = None
     try:
         suite.register(scenario)
-        group = _EnvGroup(arrays, env_ids, first_configs, scenario.name, task_kwargs, same_step)
+        group = _SharedGroup(arrays, env_ids, first_configs, scenario.name, task_kwargs, same_step)
         conn.send(None)
         clock = time.perf_counter
         while True:
@@ -408,7 +380,7 @@ class MazeVectorEnv(batch.BatchEnv):
         offsets = batch.first_configs(first, self.num_envs, num_configs)
         same_step = self.same_step
         self._conns, self._processes = [], []
-        self._local: _EnvGroup | None = None
+        self._local: _SharedGroup | None = None
         declaration = registry.get(scenario)
         with _main_module_hidden(declaration):
             for worker_id, env_ids in enumerate(self._worker_envs):
@@ -427,7 +399,7 @@ class MazeVectorEnv(batch.BatchEnv):
         try:
             if step_in_caller:  # built while the workers build theirs
                 local = shares[-1]
-                self._local = _EnvGroup(self._arrays, local, [offsets[i] for i in local], scenario, task_kwargs, same_step)
+                self._local = _SharedGroup(self._arrays, local, [offsets[i] for i in local], scenario, task_kwargs, same_step)
             self._collect()  # every worker has built its envs
             # Every process has mapped the segment now: its name can go. The
             # memory lives until the last mapping does, so nothing is left in

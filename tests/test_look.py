@@ -14,6 +14,7 @@ import pytest
 import mjmaze
 
 from mjmaze import core, look, mjcf, palette, render, sprites, viz
+from mjmaze.group import EnvGroup
 from mjmaze.tasks import base, find_return, k_item, labyrinth, two_colour
 
 from conftest import place
@@ -152,7 +153,7 @@ def object_colour(env, name, pose, animation_steps=1, first_step=0):
     """Mean colour where object ``name`` is drawn, seen from ``pose``, outside the pistol, over the
     frames of ``animation_steps`` steps of the episode from ``first_step`` (a sprite's animation:
     ViZDoom's measurements average the blink)."""
-    task, row = env.task, env.task.row
+    task, row = env.task, 0  # a dm_control env's state is a batch of one
     colours = []
     for step in range(first_step, first_step + animation_steps):
         task.state["steps"][row] = step
@@ -333,7 +334,7 @@ def test_a_sector_lit_picture_darkens_through_doom_s_colormaps():
     env = stone_room_with(sprites.BLUE_ARMOUR)
     ids = env.physics.object_ids(["item_0"])
     env.physics.place_objects(ids[0], np.array([[4.0, 0.0]]))
-    env.task.state["steps"][env.task.row] = 1  # level tic 14: frame A (sector-lit)
+    env.task.state["steps"][0] = 1  # level tic 14: frame A (sector-lit)
     frame = frame_at(env, 0.0, 0.0, 0.0)
     colour = frame[env.task.segmentation(env.physics) == ids[1][0]].astype(float).mean(axis=0)
     env.task.close()
@@ -497,18 +498,18 @@ def test_a_sprite_out_of_view_is_left_out_of_the_render_and_the_frame_is_the_sam
     physics.place_objects(geom, np.array([[0.5, 0.5]]))
     place(env, 1.5, 0.5, math.pi if ahead else 0.0)  # the item 1 m ahead, or 1 m behind
     left_out = []
-    hide = type(task)._leave_out_unseen
+    hide = EnvGroup._leave_out_unseen
 
-    def watching(self, scene, row):
-        shown = hide(self, scene, row)
+    def watching(self, scene, k, row):
+        shown = hide(self, scene, k, row)
         left_out.append(shown is not None and physics.model.geom_group[geom] == render.HIDDEN_GROUP)
         return shown
 
-    monkeypatch.setattr(type(task), "_leave_out_unseen", watching)
+    monkeypatch.setattr(EnvGroup, "_leave_out_unseen", watching)
     frame = task.get_observation(physics)["pixels"].copy()
     assert left_out == [not ahead]
     assert physics.model.geom_group[geom] == mjcf.VISIBLE_GROUP
-    monkeypatch.setattr(type(task), "_leave_out_unseen", lambda self, scene, row: None)
+    monkeypatch.setattr(EnvGroup, "_leave_out_unseen", lambda self, scene, k, row: None)
     drawn = task.get_observation(physics)["pixels"]
     seen = (task.segmentation(physics) == geom).sum()
     task.close()

@@ -35,6 +35,12 @@ MAX_MEAN_COLOUR_DIFFERENCE = 8  # of 255, per channel, over a frame
 MIN_SEGMENTATION_AGREEMENT = 0.95
 
 
+def _advance(env, action: int) -> tuple[float, bool, bool]:
+    """One step of a dm_control env: ``(reward, terminated, truncated)``, told apart by the discount (0: a task end)."""
+    step = env.step(action)
+    return float(step.reward), bool(step.last() and step.discount == 0), bool(step.last() and step.discount == 1)
+
+
 def _cpu_twins(scenario: str, kwargs: dict, num_envs: int, batch: mjwarp.MazeBatchEnv):
     """One dm_control env per world, seeded and offset as the batch env's worlds are."""
     num_configs = len(batch.task.configs)
@@ -82,7 +88,7 @@ def _plays_like_the_cpu(scenario: str, kwargs: dict, num_envs: int = 4, steps: i
                 cpu = (0.0, False, False)
                 pending[i] = False
             else:
-                cpu = task.advance(physics, int(action[i]))
+                cpu = _advance(env, int(action[i]))
             assert (float(reward[i]), bool(terminated[i]), bool(truncated[i])) == pytest.approx(cpu, abs=1e-6), (step, i)
             pending[i] = cpu[1] or cpu[2]
             for name, value in task.get_info(physics).items():
@@ -130,7 +136,7 @@ def test_head_bob_moves_each_worlds_eye_and_pistol_as_the_cpu_task():
         assert not (terminated.any() or truncated.any())
         eyes = mjwarp.wp.to_torch(batch._data.cam_xpos)[:, batch._camera, 2].numpy()
         for i, env in enumerate(cpus):
-            env.task.advance(env.physics, int(actions[i]))
+            _advance(env, int(actions[i]))
             frame = env.task.get_observation(env.physics)["pixels"]
             assert eyes[i] == pytest.approx(env.physics.named.data.cam_xpos[base.CAMERA][2], abs=1e-4), (step, i)
             # The swayed pistol covers the same pixels (its hand, drawn in its own colour on both).
@@ -279,7 +285,7 @@ def test_bad_arguments_say_what_to_do():
 # may make a long wall-sliding run drift, so the outcomes are compared as
 # statistics (a 4-sigma two-sample test on the metric and the episode length).
 # 1,000 per scenario take ~6 minutes on 2 cores: CI runs 200 (about a minute);
-# MJMAZE_WARP_EPISODES=1000 runs the full check (README, "GPU batch backend").
+# MJMAZE_WARP_EPISODES=1000 runs the full check (docs/warp_backend.md, "Design, as built").
 EPISODES = int(os.environ.get("MJMAZE_WARP_EPISODES", "200"))
 
 
@@ -305,7 +311,7 @@ def test_outcome_statistics_agree_over_random_episodes(scenario):
         env.task.reseed(SEED + i)
         env.reset()
         for step in range(base.EPISODE_STEPS):
-            _, terminated, truncated = env.task.advance(env.physics, int(actions[step, i]))
+            _, terminated, truncated = _advance(env, int(actions[step, i]))
             if terminated or truncated:
                 break
         cpu_metric[i], cpu_length[i] = env.task.metrics()[metric], env.task.steps

@@ -211,9 +211,9 @@ def mjmaze_steps(env) -> np.ndarray:
     task, physics = env.task, env.physics
     frames = []
     for step in range(MJMAZE_ANIMATION_STEPS):
-        task.state["steps"][task.row] = step
+        task.state["steps"][0] = step
         frames.append(task.get_observation(physics)["pixels"].astype(np.float64))
-    task.state["steps"][task.row] = 0
+    task.state["steps"][0] = 0
     return np.array(frames)
 
 

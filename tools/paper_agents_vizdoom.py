@@ -288,7 +288,7 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
         for step, (x, y, yaw, action, things, flashes, doom, shifted) in enumerate(path):
             if two_colour:
                 _place_two_colour_things(task, env.physics, things, flashes, hide_items, starts)
-            task.state["steps"][task.row] = step  # the things' animations at ViZDoom's tic of this pose
+            task.state["steps"][0] = step  # the things' animations at ViZDoom's tic of this pose
             env.physics.set_agent_pose(x, y, yaw)
             env.physics.forward()
             frame = np.ascontiguousarray(task.get_observation(env.physics)["pixels"])
@@ -501,12 +501,12 @@ def swap(name: str, checkout: str, sight: str, mazes: int = 64, plays: int = 4,
                         things = [label.value for label in state.labels if label.object_name != "DoomPlayer"]
                         covered = cv2.resize(np.isin(state.labels_buffer, things).astype(np.float32), SIZE,
                                              interpolation=cv2.INTER_AREA)
-                        shown = task.state["object_shown"][task.row].copy()
-                        task.state["object_shown"][task.row] = False
-                        task._sync_objects(physics)
+                        shown = task.state["object_shown"][0].copy()
+                        task.state["object_shown"][0] = False
+                        task.sync_objects(physics)
                         bare = task.get_observation(physics)["pixels"]
-                        task.state["object_shown"][task.row] = shown
-                        task._sync_objects(physics)
+                        task.state["object_shown"][0] = shown
+                        task.sync_objects(physics)
                         ours_drawn = (frame != bare).any(axis=-1)
                         weight = np.maximum(covered, ours_drawn)[..., None]
                         things_from, scenery_from = (frame, doom) if sight == "vizdoom-scenery" else (doom, frame)
@@ -582,7 +582,7 @@ def picks(name: str, checkout: str, mazes: int = 32, wad: str | None = None) -> 
     task = env.task
     for _ in range(PLAYS_PER_MAZE * mazes):
         timestep, player = env.reset(), policy.Policy(agent)
-        totem_green = bool(task.totem_green) if task.state["object_shown"][task.row, 0] else None
+        totem_green = bool(task.totem_green) if task.state["object_shown"][0, 0] else None
         steps, right, wrong, on_floor = 0, 0, 0, task.item_active.copy()
         while not timestep.last():
             timestep = env.step(player.act(timestep.observation["pixels"]))
@@ -685,7 +685,7 @@ def blink(name: str, checkout: str, mazes: int = 8, steps: int = 300, wad: str |
             for geom, pixels in zip(ids.tolist(), visible.tolist()):
                 if geom in by_geom and pixels >= 2:  # 15 of 320x180's pixels are ~2 of 112x64's
                     doom, k = by_geom[geom]
-                    age = clock - int(task.state["animation_start"][task.row, k])
+                    age = clock - int(task.state["animation_start"][0, k])
                     cycle = sum(tics for _, tics, _ in kinds[doom].frames)
                     frame = int(sprites.frame_of_tic(kinds[doom], cycle)[age % cycle])
                     seen = counts["mjmaze"].setdefault(doom, [0, 0])
@@ -730,7 +730,7 @@ def _place_two_colour_things(task, physics, things: tuple[list, bool | None], fl
     from mjmaze.tasks import two_colour
 
     items, totem_green = things
-    state, row = task.state, task.row
+    state, row = task.state, 0  # a dm_control env: a batch of one
     state["object_shown"][row, 0] = totem_green is not None
     if totem_green is not None:
         state["totem_green"][row] = totem_green
@@ -745,7 +745,7 @@ def _place_two_colour_things(task, physics, things: tuple[list, bool | None], fl
                 state["animation_start"][row, 1 + slot] = starts[object_id]
     state["object_xy"][row, 1:], state["object_shown"][row, 1:] = xy, shown
     state["damage_count"][row], state["bonus_count"][row] = flashes
-    task._sync_objects(physics, everything=True)
+    task.sync_objects(physics, everything=True)
 
 
 def main() -> None:

@@ -4,7 +4,7 @@
     python -m mjmaze.train.evaluate random --scenario labyrinth --size 7   # a uniformly random policy, the same way
     python -m mjmaze.train.evaluate paper:two_colour_5 --plays 8 --seed 1  # more episodes, other draws
 
-**Decision** (also in the README): each of the first 64 test configurations, and
+**Decision** (docs/training.md): each of the first 64 test configurations, and
 64 training ones, is played twice to its end or the time limit - 128 episodes
 per split - rather than the released "first 128 episodes to finish", which
 favoured short episodes (``--plays`` more times each where the draws' noise

@@ -299,12 +299,12 @@ class TwoColour(core.MazeRules):
     @property
     def item_xy(self) -> np.ndarray:
         """``(POOL_SIZE, 2)``: where each item of the pool is (a view: writes move them)."""
-        return self.state["object_xy"][self.row, 1:]
+        return self.state["object_xy"][0, 1:]
 
     @property
     def item_active(self) -> np.ndarray:
         """``(POOL_SIZE,)``: which items are on the floor (a view)."""
-        return self.state["object_shown"][self.row, 1:]
+        return self.state["object_shown"][0, 1:]
 
     @property
     def item_green(self) -> np.ndarray:
@@ -313,19 +313,19 @@ class TwoColour(core.MazeRules):
 
     @property
     def items_spawned(self) -> int:
-        return int(self.state["items_spawned"][self.row])
+        return int(self.state["items_spawned"][0])
 
     @property
     def totem_green(self) -> bool:
-        return bool(self.state["totem_green"][self.row])
+        return bool(self.state["totem_green"][0])
 
     @property
     def health(self) -> int:
-        return int(self.state["health"][self.row])
+        return int(self.state["health"][0])
 
     @health.setter
     def health(self, value: int) -> None:
-        self.state["health"][self.row] = value
+        self.state["health"][0] = value
 
 
 SCENARIO = registry.Scenario(
