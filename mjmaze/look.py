@@ -15,7 +15,7 @@ from collections.abc import Sequence
 import mujoco
 import numpy as np
 
-from mjmaze import core, mjcf, palette, rules, sprites, walls
+from mjmaze import compiled_light, core, mjcf, palette, rules, sprites, walls
 
 # Head-bob: Doom's P_CalcHeight and P_BobWeapon. Walking swings the eye by half
 # the "bob", min(v^2 / 4, 16) map units with v the speed after the tic's thrust
@@ -253,6 +253,19 @@ class DoomLight:
         self._white = xp.asarray(254.5, dtype=xp.float32, device=device)
         self._top_bin = xp.asarray(_LIGHT_BINS - 1, dtype=xp.float32, device=device)
         self._half = xp.asarray(0.5, dtype=xp.float32, device=device)
+        # On the CPU, one compiled pass gives the same frames ~3x sooner (mjmaze.compiled_light), where numba is.
+        self._compiled = self._compiled_constants(up < 0) if rules.on_host(xp) and compiled_light.available() else None
+
+    def _compiled_constants(self, below: np.ndarray) -> tuple:
+        """What :func:`mjmaze.compiled_light.light` takes beside the frames: this light's tables and
+        constants as float32, as the numpy path computes with them (NEP 50: a Python float meets a
+        float32 array as float32)."""
+        f32 = np.float32
+        return (self._right, self._up, below, np.ascontiguousarray(self._gains),
+                np.ascontiguousarray(self._flat_start[:, 0]), f32(self._cell), f32(self._half_grid), f32(self._face),
+                f32(self._on_face), f32(_ON_PLANE), f32(walls.WALL_HEIGHT - _ON_PLANE), f32(_LIGHT_BINS * _NEAREST),
+                f32(_LIGHT_BINS - 1), (NORTH_SOUTH_WALL * _LIGHT_BINS, EAST_WEST_WALL * _LIGHT_BINS),
+                self._thing_start)
 
     def _off_wall_face(self, cells):
         """Cells from a coordinate (in cells from the grid's first line) to the nearest wall face across it."""
@@ -281,6 +294,10 @@ class DoomLight:
         xp = self._xp
         eye, yaw = xp.astype(eye, xp.float32), xp.astype(yaw, xp.float32)
         cos, sin = xp.cos(yaw), xp.sin(yaw)
+        if self._compiled is not None:
+            lit = np.empty(frames.shape, dtype=np.uint8)
+            compiled_light.light(frames, inverse_depth, eye, cos, sin, self._compiled, lit)
+            return lit
         # The floor and the ceiling: pixels at least as deep as their row's ray meets the plane.
         height_above = xp.where(self._below, eye[:, 2:3] - _ON_PLANE, walls.WALL_HEIGHT - _ON_PLANE - eye[:, 2:3])
         flat = inverse_depth < (self._up / height_above)[:, :, None]  # (B, H, W)

@@ -191,7 +191,7 @@ def make_vector_env(num_envs: int, scenario: str = suite.DEFAULT_SCENARIO, backe
 
     ``"cpu"``: :class:`MazeVectorEnv` (worker processes, numpy arrays);
     ``"warp"``: :class:`mjmaze.warp.MazeBatchEnv` (every env in one MuJoCo Warp
-    model on a GPU, torch tensors; ``pip install "mjmaze[warp]"``). ``kwargs``
+    model on a GPU, torch tensors; ``pip install -e ".[warp]"`` in a clone of mjmaze). ``kwargs``
     go to the chosen class (its options and the scenario's task arguments).
     """
     if backend == "cpu":
@@ -200,7 +200,7 @@ def make_vector_env(num_envs: int, scenario: str = suite.DEFAULT_SCENARIO, backe
         try:
             from mjmaze.warp import MazeBatchEnv
         except ImportError as error:
-            raise ImportError(f'backend="warp" needs MuJoCo Warp and torch: pip install "mjmaze[warp]" ({error})') from None
+            raise ImportError(f'backend="warp" needs MuJoCo Warp and torch: pip install -e ".[warp]" in a clone of mjmaze ({error})') from None
         return MazeBatchEnv(num_envs, scenario, **kwargs)
     raise ValueError(f"backend must be 'cpu' or 'warp', got {backend!r}")
 

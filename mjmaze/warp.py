@@ -26,7 +26,7 @@ chosen among one mesh per wall layout (``geom_dataid``), and objects are
 coloured by ``geom_rgba``. An object that collides has a second, invisible
 geom for contacts, moved below the floor with it when it is hidden.
 
-Install with ``pip install "mjmaze[warp]"``; importing :mod:`mjmaze` never
+Install with ``pip install -e ".[warp]"`` in a clone of mjmaze; importing :mod:`mjmaze` never
 imports Warp or torch, only this module does.
 """
 

@@ -6,6 +6,8 @@ these tests hold them, so they run without ViZDoom.
 """
 
 import math
+import subprocess
+import sys
 
 import mujoco
 import numpy as np
@@ -13,10 +15,11 @@ import pytest
 
 import mjmaze
 
-from mjmaze import core, look, mjcf, palette, render, sprites, viz
+from mjmaze import compiled_light, core, look, mjcf, palette, render, sprites, viz
 from mjmaze.group import EnvGroup
 from mjmaze.tasks import base, find_return, k_item, labyrinth, two_colour
 
+import golden_frames as golden
 from conftest import place
 
 # Mean colour tolerance per channel, in grey levels (0-255).
@@ -515,3 +518,58 @@ def test_a_sprite_out_of_view_is_left_out_of_the_render_and_the_frame_is_the_sam
     task.close()
     assert np.array_equal(frame, drawn)
     assert (seen > 0) == ahead  # ahead, the item is in the frame
+
+
+needs_numba = pytest.mark.skipif(not compiled_light.available(), reason="numba is not installed (the fast extra)")
+
+
+@needs_numba
+@pytest.mark.parametrize("scenario", ["labyrinth", "two_colour"])
+def test_the_compiled_light_gives_the_numpy_lights_frames_bit_for_bit(scenario, monkeypatch):
+    # The golden episodes' frames (walls near and far, floor, ceiling, items before walls and
+    # across grid lines), each lit both ways.
+    compared = []
+    numpy_light = look.DoomLight.__call__
+
+    def both_ways(self, frames, inverse_depth, eye, yaw):
+        lit = numpy_light(self, frames, inverse_depth, eye, yaw)
+        compiled, self._compiled = self._compiled, None
+        try:
+            assert np.array_equal(lit, numpy_light(self, frames, inverse_depth, eye, yaw))
+        finally:
+            self._compiled = compiled
+        compared.append(compiled is not None)
+        return lit
+
+    monkeypatch.setattr(look.DoomLight, "__call__", both_ways)
+    golden.play(scenario, golden.SEEDS[0])
+    assert len(compared) > golden.STEPS and all(compared)
+
+
+_LIGHT_THEN_GL = """
+import numpy as np
+from mjmaze import compiled_light, look
+light = look.DoomLight(np, "cpu", 112, 64, 5, 1.0)
+assert light._compiled is not None
+light(np.zeros((1, 64, 112, 3), np.uint8), np.full((1, 64, 112), 0.5, np.float32), np.zeros((1, 3)), np.zeros(1))
+import mjmaze
+print(mjmaze.load("labyrinth", task_kwargs={"size": 5}).reset().observation["pixels"].mean() > 0)
+"""
+_GL_THEN_LIGHT = """
+import mjmaze
+env = mjmaze.load("labyrinth", task_kwargs={"size": 5})
+env.reset()
+from mjmaze import compiled_light
+compiled_light._light.recompile()  # compiled now, with Mesa's LLVM loaded
+print(env.step(2).observation["pixels"].mean() > 0)
+"""
+
+
+@needs_numba
+@pytest.mark.slow
+@pytest.mark.parametrize("script", [_LIGHT_THEN_GL, _GL_THEN_LIGHT], ids=["light first", "gl first"])
+def test_numbas_llvm_and_mesas_llvmpipe_live_in_one_process_in_either_order(script):
+    # Mesa's llvmpipe links its own LLVM; triton's once crashed beside it (mjmaze/llvm_clash.py).
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.strip().splitlines()[-1] == "True"

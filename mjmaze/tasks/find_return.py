@@ -8,8 +8,9 @@ Rewards
     +0.5 for touching the red pillar (the target); after that, +0.5 for touching
     the green pillar (the return); -0.0001 per tic (-0.0004 per agent step).
     As released, the target and return items are invisible and sit on the
-    pillars: the pillars are the only cues. Touching = the agent's centre within
-    0.3 m of the pillar's centre (the agent is stopped at 0.25 m).
+    pillars: the pillars are the only cues. Touching = Doom's pick-up test after
+    any tic: the agent's centre within ``rules.PICKUP_RADIUS`` (36 map units,
+    0.28 m) of the pillar's centre in x and in y (the agent is stopped at 0.25 m).
 Termination
     The return collected (discount 0) or 525 agent steps (discount 1).
 Arguments

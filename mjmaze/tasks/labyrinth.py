@@ -12,7 +12,8 @@ Termination
     Reaching the exit (discount 0) or 525 agent steps (discount 1).
 Arguments
     ``size`` (5, 7, 9, 11, 13), ``split``, ``num_configs``, ``config_sampling``,
-    ``first_config``, ``action_set``, ``width``, ``height``, ``random``.
+    ``first_config``, ``layouts``, ``action_set``, ``width``, ``height``,
+    ``visual_style``, ``head_bob``, ``flashes``, ``random``.
 Metric
     ``success``: whether the exit was reached (success rate = mean over episodes).
 Version History
