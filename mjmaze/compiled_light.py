@@ -17,6 +17,7 @@ symbols), so it and Mesa's llvmpipe live in one process in either order
 
 from __future__ import annotations
 
+import functools
 import os
 
 import numpy as np
@@ -24,15 +25,11 @@ import numpy as np
 #: Set to "0" to keep Doom's light on numpy even where numba is installed.
 SWITCH_VARIABLE = "MJMAZE_COMPILED_LIGHT"
 
-try:
-    import numba
-except ImportError:  # numba is an extra; numba that refuses this numpy raises ImportError too
-    numba = None
-
 
 def available() -> bool:
-    """Whether the compiled light is used: numba imports and :data:`SWITCH_VARIABLE` is not "0"."""
-    return numba is not None and os.environ.get(SWITCH_VARIABLE, "1") != "0"
+    """Whether the compiled light is used: :data:`SWITCH_VARIABLE` is not "0" and numba imports
+    (imported then, not with mjmaze; docs/speed.md has what it costs in memory)."""
+    return os.environ.get(SWITCH_VARIABLE, "1") != "0" and _compiled() is not None
 
 
 def _light(frames, inverse_depth, eye, cos, sin, right, up_tangent, below, gains, flat_start, cell, half_grid, face,
@@ -88,13 +85,21 @@ def _surface_start(base_x, base_y, c, s, right, depth, cell, face, on_face, wall
     return wall_rows[1] if off_y < off_x else wall_rows[0]
 
 
-if numba is not None:
+@functools.cache
+def _compiled():
+    """:func:`_light` compiled (on its first call; from numba's cache after), or None without numba."""
+    global _surface_start
+    try:
+        import numba
+    except ImportError:  # numba is an extra; a numba that refuses this numpy raises ImportError too
+        return None
+    # _light calls _surface_start by its global name: compiled, so that numba compiles the call.
     _surface_start = numba.njit(cache=True, inline="always")(_surface_start)
-    _light = numba.njit(cache=True)(_light)
+    return numba.njit(cache=True)(_light)
 
 
 def light(frames: np.ndarray, inverse_depth: np.ndarray, eye: np.ndarray, cos: np.ndarray, sin: np.ndarray,
           constants: tuple, out: np.ndarray) -> None:
     """Writes ``frames`` (uint8 ``(B, H, W, 3)``) in Doom's light into ``out``; the other arrays and
     ``constants`` (float32, :meth:`mjmaze.look.DoomLight._compiled_constants`) as the numpy path has them."""
-    _light(frames, inverse_depth, eye, cos, sin, *constants, out)
+    _compiled()(frames, inverse_depth, eye, cos, sin, *constants, out)

@@ -560,7 +560,7 @@ import mjmaze
 env = mjmaze.load("labyrinth", task_kwargs={"size": 5})
 env.reset()
 from mjmaze import compiled_light
-compiled_light._light.recompile()  # compiled now, with Mesa's LLVM loaded
+compiled_light._compiled().recompile()  # compiled now, with Mesa's LLVM loaded
 print(env.step(2).observation["pixels"].mean() > 0)
 """
 
