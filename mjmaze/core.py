@@ -23,18 +23,12 @@ from typing import Any, TypedDict
 
 import numpy as np
 
-from mjmaze import configs, mjcf, palette, rules
+from mjmaze import configs, doom, mjcf, palette, rules
 from mjmaze import layouts as layout_files
 
-# Timing: one physics step is one Doom tic (35 a second); the agent acts every 4 tics.
-TICS_PER_SECOND = 35
-TICS_PER_STEP = 4
-STEPS_PER_SECOND = TICS_PER_SECOND / TICS_PER_STEP  # real time: 8.75 observations a second
+# Timing: one physics step is one Doom tic (mjmaze.doom); the agent acts every 4 tics.
+STEPS_PER_SECOND = doom.TICS_PER_SECOND / doom.TICS_PER_STEP  # real time: 8.75 observations a second
 EPISODE_STEPS = 525  # 2100 tics
-#: ViZDoom's episode clock (``GameState.tic``) at the first observation; an agent step adds
-#: ``TICS_PER_STEP``. Things' animations run on it (:meth:`MazeRules.animation_start`).
-FIRST_OBSERVATION_TIC = 1
-PICKUP_RADIUS = rules.PICKUP_RADIUS
 AGENT_RADIUS = 0.125
 
 DEFAULT_WIDTH, DEFAULT_HEIGHT = 112, 64

@@ -16,7 +16,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from mjmaze import configs, core, look, mjcf, render, walls
+from mjmaze import configs, core, doom, look, mjcf, render, walls
 from mjmaze.physics import MazePhysics
 
 CAMERA = mjcf.EGO_CAMERA
@@ -61,7 +61,7 @@ class EnvGroup:
         self._sprite_ids = sprites.geom_ids if sprites is not None and len(sprites) else None
         self._xy_in_model = [np.empty((0, 2))] * count
         self._shown_in_model = [np.empty(0, dtype=bool)] * count
-        self._paths = np.zeros((count, core.TICS_PER_STEP, 2))
+        self._paths = np.zeros((count, doom.TICS_PER_STEP, 2))
         self._buffers: tuple[np.ndarray, np.ndarray | None] | None = None
 
     def __len__(self) -> int:
@@ -115,7 +115,7 @@ class EnvGroup:
         for row in rows:
             physics = self.physics[row]
             physics.command = table[int(actions[row])]
-            physics.step(core.TICS_PER_STEP)
+            physics.step(doom.TICS_PER_STEP)
         return self.end_step(rows)
 
     def end_step(self, rows: Sequence[int]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

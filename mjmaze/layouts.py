@@ -23,9 +23,8 @@ import pathlib
 
 import numpy as np
 
-from mjmaze import configs, registry
+from mjmaze import configs, doom, registry
 
-DOOM_UNITS_PER_METRE = 128.0
 # How far (in cells) a coordinate may be off the grid and still snap to it.
 _GRID_TOLERANCE = 0.1
 
@@ -59,7 +58,7 @@ def from_paper_json(path: str | os.PathLike, scenario: str, index: int = 0, spli
             return array.reshape(0, width)
         if array.ndim != 2 or array.shape[1] != width or not np.isfinite(array).all():
             raise fail(field, f"expected a list of {width} numbers per entry, got {value!r:.80}")
-        return array / DOOM_UNITS_PER_METRE
+        return array / doom.UNITS_PER_METRE
 
     def field(name: str):
         if name not in data:

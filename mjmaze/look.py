@@ -15,7 +15,7 @@ from collections.abc import Sequence
 import mujoco
 import numpy as np
 
-from mjmaze import compiled_light, core, mjcf, palette, rules, sprites, walls
+from mjmaze import compiled_light, doom, mjcf, palette, rules, sprites, walls
 
 # Head-bob: Doom's P_CalcHeight and P_BobWeapon. Walking swings the eye by half
 # the "bob", min(v^2 / 4, 16) map units with v the speed after the tic's thrust
@@ -23,7 +23,6 @@ from mjmaze import compiled_light, core, mjcf, palette, rules, sprites, walls
 # whole bob (in 320x180 screen pixels) with a 64-tic period. The phases run on
 # the level's clock, which the released configs start at tic 10.
 MAX_BOB = 16.0  # map units (Doom's MAXBOB)
-EPISODE_START_TIC = 10  # the released .cfg files' episode_start_time
 EYE_BOB_TICS = 20
 PISTOL_BOB_TICS = 64
 PISTOL_BOB_PIXELS = (0.751 / 320, 0.903 / 180)  # (x, y) shift per unit of bob, as fractions of the frame
@@ -41,7 +40,7 @@ PISTOL = (
 
 def walking_bob(xp, vx, vy, timestep: float):
     """Doom's bob in map units of a tic whose velocity after its thrust is ``(vx, vy)`` (m/s)."""
-    speed_sq = (vx * vx + vy * vy) * (timestep / mjcf.MAP_UNIT) ** 2  # (map units per tic)^2
+    speed_sq = (vx * vx + vy * vy) * (timestep / doom.MAP_UNIT) ** 2  # (map units per tic)^2
     return rules.at_most(xp, speed_sq / 4, MAX_BOB)
 
 
@@ -51,8 +50,8 @@ def view_bob(xp, bob, tics):
     ``eye_dz`` in metres (up), the pistol's shift as fractions of the frame
     (right, down). Works on floats (``xp = math``) and arrays.
     """
-    level_time = EPISODE_START_TIC + tics
-    eye_dz = bob / 2 * xp.sin(math.tau * (level_time - 1) / EYE_BOB_TICS) * mjcf.MAP_UNIT
+    level_time = doom.EPISODE_START_TIC + tics
+    eye_dz = bob / 2 * xp.sin(math.tau * (level_time - 1) / EYE_BOB_TICS) * doom.MAP_UNIT
     angle = math.tau * level_time / PISTOL_BOB_TICS
     pistol_dx = bob * xp.cos(angle) * PISTOL_BOB_PIXELS[0]
     pistol_dy = bob * abs(xp.sin(angle)) * PISTOL_BOB_PIXELS[1]
@@ -369,7 +368,7 @@ class FramePipeline:
         xp = self._xp
         scene = {}
         if self._head_bob:
-            eye_dz, pistol_dx, pistol_dy = view_bob(xp, bob, state["steps"] * core.TICS_PER_STEP)
+            eye_dz, pistol_dx, pistol_dy = view_bob(xp, bob, state["steps"] * doom.TICS_PER_STEP)
             scene["eye_dz"] = eye_dz
             scene["pistol"] = (xp.astype(xp.round(pistol_dx * self._width), xp.int64),
                                xp.astype(xp.round(pistol_dy * self._height), xp.int64))
@@ -377,7 +376,7 @@ class FramePipeline:
             still = xp.zeros(state["steps"].shape, dtype=xp.int64, device=self._device)
             scene["eye_dz"], scene["pistol"] = xp.astype(still, xp.float64), (still, still)
         if self.sprites is not None and len(self.sprites):
-            clock = core.FIRST_OBSERVATION_TIC + state["steps"] * core.TICS_PER_STEP
+            clock = doom.FIRST_OBSERVATION_TIC + state["steps"] * doom.TICS_PER_STEP
             objects = self._sprite_objects
             ages = clock[:, None] - xp.take(state["animation_start"], objects, axis=1)
             scene["sprite_material"], scene["sprite_quat"], scene["sprite_in_view"] = self.sprites(

@@ -19,7 +19,7 @@ from collections.abc import Sequence
 import mujoco
 import numpy as np
 
-from mjmaze import palette, sprites, walls
+from mjmaze import doom, palette, sprites, walls
 
 #: ``visual_style`` values: "textured" (the default) gives walls and floor
 #: textures whose texels keep their size in the world and light that falls off
@@ -35,7 +35,6 @@ VISUAL_STYLES = ("textured", "flat")
 #: 20 m) stepped no faster within the noise and moved a few pixels in a
 #: million, so they stay (CHANGELOG.md, "Speed measurements").
 LIT_QUAD = 0.5
-MAP_UNIT = 1 / 128  # metres per Doom map unit (a 128-unit cell is 1 m)
 EGO_CAMERA = "ego"  # the agent's eye (xml_templates/arena.xml)
 VISIBLE_GROUP = 1  # the geom group of an object the agent sees (mjmaze.render.HIDDEN_GROUP: one it does not)
 ARENA_BODY = "arena"  # build_xml's batch arena: the body holding what differs between worlds
@@ -94,7 +93,7 @@ def floor_thing(name: str, shape: str, width: float, height: float, rgba, collid
     (``shape="cylinder"``, or a ``"sphere"`` of diameter ``width``) in ``rgba``
     shows the same width from every side.
     """
-    radius, height = width / 2 * MAP_UNIT, height * MAP_UNIT
+    radius, height = width / 2 * doom.MAP_UNIT, height * doom.MAP_UNIT
     if shape == "sphere":
         return ObjectGeom(name, "sphere", (radius,), rgba, radius, collides, sprite=sprite)
     return ObjectGeom(name, "cylinder", (radius, height / 2), rgba, height / 2, collides, sprite=sprite)
@@ -297,7 +296,7 @@ def surface_texels(texture: str, colour: tuple[float, float, float]) -> tuple[np
     material's colour under 1 (then the brightest few saturate).
     """
     grey = sprites.surface(texture).astype(np.float64).mean(axis=2)
-    metre = round(1 / MAP_UNIT)
+    metre = round(1 / doom.MAP_UNIT)
     grey = np.tile(grey, (-(-metre // grey.shape[0]), -(-metre // grey.shape[1])))[:metre, :metre]
     fold = metre // palette.TEXTURE_TEXELS
     grey = grey.reshape(palette.TEXTURE_TEXELS, fold, palette.TEXTURE_TEXELS, fold).mean(axis=(1, 3))
@@ -378,7 +377,7 @@ def sprite_material(sprite: sprites.Sprite, frame: int, depth_bin: int) -> str:
 
 def unit_depth(width: int) -> float:
     """Metres ahead at which a sprite pixel (a map unit) spans one pixel of a ``width``-wide frame."""
-    return DOOM_FOCAL_ACROSS * width * MAP_UNIT
+    return DOOM_FOCAL_ACROSS * width * doom.MAP_UNIT
 
 
 def _add_sprite(asset: ET.Element, obj: ObjectGeom, width: int) -> tuple[dict, tuple]:
@@ -394,7 +393,7 @@ def _add_sprite(asset: ET.Element, obj: ObjectGeom, width: int) -> tuple[dict, t
     if asset.find(f"mesh[@name='{name}']") is None:
         # Compiled from the quads nudged apart (the compiler merges no vertex
         # and finds a volume), recentred by it: write_sprites writes them as they are.
-        verts, texcoords = sprites.mesh_quads(obj.sprite, obj.z, MAP_UNIT)
+        verts, texcoords = sprites.mesh_quads(obj.sprite, obj.z, doom.MAP_UNIT)
         verts[..., 0] += np.arange(4) * 1e-3
         faces = walls.quad_faces(len(verts))
         ET.SubElement(asset, "mesh", name=name, inertia="shell",
@@ -436,7 +435,7 @@ def write_sprites(model: mujoco.MjModel, objects: Sequence[ObjectGeom], width: i
             for depth_bin in range(texels.shape[1]):
                 _paint(model, sprite_material(obj.sprite, frame, depth_bin), texels[frame, depth_bin])
         mesh = model.geom_dataid[geom]
-        verts, texcoords = sprites.mesh_quads(obj.sprite, obj.z, MAP_UNIT)
+        verts, texcoords = sprites.mesh_quads(obj.sprite, obj.z, doom.MAP_UNIT)
         verts, texcoords = verts.reshape(-1, 3), texcoords.reshape(-1, 2)
         if model.mesh_vertnum[mesh] != len(verts) or model.mesh_texcoordnum[mesh] != len(texcoords):
             raise RuntimeError(f"the compiled mesh {_sprite_asset(obj.sprite)} is not its quads: vertices were merged")

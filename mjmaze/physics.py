@@ -16,17 +16,15 @@ import mujoco as mj
 import numpy as np
 from dm_control import mujoco
 
-from mjmaze import core, look, mjcf, render
+from mjmaze import doom, look, mjcf, render
 
-TICS_PER_STEP = core.TICS_PER_STEP
 # Motion: Doom's player movement, tic by tic (ZDoom's P_MovePlayer and
 # P_XYMovement; measured in ViZDoom, see docs/motion.md). A held forward key
 # adds a walking thrust to the velocity each tic and friction keeps 0.90625 of
 # it after the tic's move, so the agent gathers speed over ~3 agent steps and
 # coasts after letting go; a turn key turns 3.52 degrees a tic, half that for
 # the first 5 tics it is held.
-MAP_UNIT = mjcf.MAP_UNIT  # metres
-THRUST_PER_TIC = 25 * 2048 / 65536 * MAP_UNIT  # m/tic gained per tic: forwardmove 0x19 (walking)
+THRUST_PER_TIC = 25 * 2048 / 65536 * doom.MAP_UNIT  # m/tic gained per tic: forwardmove 0x19 (walking)
 FRICTION = 0xE800 / 0x10000  # share of the velocity a tic keeps
 # A tic a wall or a pillar stops the agent, Doom's slide move keeps as velocity
 # only the part of the tic's move left after reaching the wall, slid along it,
@@ -39,8 +37,8 @@ _BLOCKED_SQ = 1e-4**2
 TURN_PER_TIC = math.tau * 640 / 65536  # radians: angleturn 640 of a 65536 turn
 SLOW_TURN_TICS = 5  # a turn key's first tics turn at half rate (ZDoom's SLOWTURNTICS)
 # At full speed in open space: 0.261 m and 14.06 degrees per agent step.
-FORWARD_PER_STEP = TICS_PER_STEP * THRUST_PER_TIC / (1 - FRICTION)
-TURN_PER_STEP = TICS_PER_STEP * TURN_PER_TIC
+FORWARD_PER_STEP = doom.TICS_PER_STEP * THRUST_PER_TIC / (1 - FRICTION)
+TURN_PER_STEP = doom.TICS_PER_STEP * TURN_PER_TIC
 VISIBLE_GROUP = mjcf.VISIBLE_GROUP
 
 

@@ -20,12 +20,9 @@ from typing import Any
 
 import array_api_compat
 
-Array = Any  # a numpy array or a torch tensor
+from mjmaze import doom
 
-#: An item is picked up when the agent's centre comes this close in x and in y
-#: (metres): Doom touches things by squares aligned with the map, the item's
-#: radius (20 map units, every pickup the scenarios use) plus the player's (16).
-PICKUP_RADIUS = 36 / 128
+Array = Any  # a numpy array or a torch tensor
 
 _MASK32 = 0xFFFFFFFF
 # What a draw is for: the first counter of every uniform(), so draws for
@@ -71,7 +68,7 @@ def within_reach(xp, points: Array, path: Array) -> Array:
     after each tic of the step (Doom tests pick-ups every tic).
     """
     offsets = points[:, :, None, :] - path[:, None, :, :]  # (B, n, tics, 2)
-    return xp.max(xp.abs(offsets), axis=-1) < PICKUP_RADIUS
+    return xp.max(xp.abs(offsets), axis=-1) < doom.PICKUP_RADIUS
 
 
 def reached(xp, points: Array, path: Array) -> Array:

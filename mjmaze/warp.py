@@ -42,7 +42,7 @@ from gymnasium.vector import AutoresetMode
 
 import mujoco_warp as mjw
 import warp as wp
-from mjmaze import batch, core, look, mjcf, physics, rules, suite, walls
+from mjmaze import batch, core, doom, look, mjcf, physics, rules, suite, walls
 
 # Where a geom that must not be seen or touched in a world goes (below the floor).
 _AWAY_Z = -50.0
@@ -215,7 +215,7 @@ class MazeBatchEnv(batch.BatchEnv):
         self._episodes = torch.zeros(n, dtype=torch.int64, device=dev)
         self._config_index = torch.zeros(n, dtype=torch.int64, device=dev)
         self._ended = torch.zeros(n, dtype=torch.bool, device=dev)
-        self._path = torch.zeros((n, core.TICS_PER_STEP, 2), dtype=torch.float64, device=dev)
+        self._path = torch.zeros((n, doom.TICS_PER_STEP, 2), dtype=torch.float64, device=dev)
         self._turn_held = torch.zeros(n, dtype=torch.float64, device=dev)  # tics a turn key has been held
         self._bob = torch.zeros(n, dtype=torch.float64, device=dev)  # Doom's walking bob of the last tic
         self._obs = torch.zeros((n, height, width, 3), dtype=torch.uint8, device=dev)

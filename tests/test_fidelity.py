@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import mjmaze
-from mjmaze import layouts, mjcf, palette, render, sprites, walls
+from mjmaze import doom, layouts, mjcf, palette, render, sprites, walls
 from mjmaze.tasks import base, find_return, k_item, two_colour
 
 from conftest import FORWARD, place
@@ -149,8 +149,8 @@ def test_floor_and_ceiling_show_their_flats_laid_as_in_the_released_maps(scenari
     floor, ceiling = flat_views(task, centre, extent, pixels)
     env.close()
     offsets = (np.arange(pixels) + 0.5 - pixels / 2) * extent / pixels
-    map_x = (centre[0] + offsets[None, :] - task.layout.cell_size / 2) / mjcf.MAP_UNIT  # map units
-    map_y = (centre[1] - offsets[:, None] - task.layout.cell_size / 2) / mjcf.MAP_UNIT
+    map_x = (centre[0] + offsets[None, :] - task.layout.cell_size / 2) / doom.MAP_UNIT  # map units
+    map_y = (centre[1] - offsets[:, None] - task.layout.cell_size / 2) / doom.MAP_UNIT
     for view, texture in ((floor, task.room.floor_texture), (ceiling, task.room.ceiling_texture)):
         # mjmaze draws a flat in texels of 2 x 2 map units (mjcf.surface_texels).
         grey = sprites.surface(texture).astype(np.float64).mean(axis=2).reshape(32, 2, 32, 2).mean(axis=(1, 3))
@@ -171,7 +171,7 @@ def beside(env, xy):
     """0.125 m before ``xy`` in x and 0.28 m to its side, facing +x: out of reach (0.307 m)
     before and after one forward step, in reach at its middle."""
     place(env, xy[0] - 0.125, xy[1] + 0.28, 0.0)
-    assert math.hypot(0.125, 0.28) > base.PICKUP_RADIUS
+    assert math.hypot(0.125, 0.28) > doom.PICKUP_RADIUS
 
 
 def test_an_exit_passed_mid_step_is_reached():
@@ -229,8 +229,8 @@ def test_the_agent_stops_at_its_radius_from_a_wall_at_every_tic(heading):
         assert path[-1, 1] > -2.0 + 4.0  # slid along the wall
 
 
-@pytest.mark.parametrize("angle, doom", [(20, 8.4), (45, 17.4), (70, 22.9)])
-def test_the_agent_slides_along_a_wall_as_slowly_as_in_vizdoom(angle, doom):
+@pytest.mark.parametrize("angle, vizdoom_slide", [(20, 8.4), (45, 17.4), (70, 22.9)])
+def test_the_agent_slides_along_a_wall_as_slowly_as_in_vizdoom(angle, vizdoom_slide):
     # Forward held into a wall at an angle from its normal: Doom's slide move keeps 31/32 of the
     # slid momentum a tic (P_SlideMove's FUDGE), so the agent slides at 74% of the speed friction
     # alone leaves. ViZDoom's steady slide, map units a step (python tools/doom_motion.py --wall-slide).
@@ -240,8 +240,8 @@ def test_the_agent_slides_along_a_wall_as_slowly_as_in_vizdoom(angle, doom):
     place(env, 0.0, face - 0.3, math.radians(90 - angle))  # toward the north wall, angle east of its normal
     path = push(env, FORWARD, 12)[3::4]  # the agent's place after each step
     assert path[-1, 1] == pytest.approx(face - base.AGENT_RADIUS, abs=TOLERANCE)  # against the wall
-    slide = (path[-1, 0] - path[-2, 0]) / base.MAP_UNIT
-    assert slide == pytest.approx(doom, rel=0.06)
+    slide = (path[-1, 0] - path[-2, 0]) / doom.MAP_UNIT
+    assert slide == pytest.approx(vizdoom_slide, rel=0.06)
 
 
 def free_wall_end(env):
@@ -289,8 +289,8 @@ def test_the_tic_it_meets_a_wall_the_agent_keeps_only_the_rest_of_its_move():
     env = load("two_colour", complexity=0, item_cap=0)
     env.task.health = 10**6
     face = 5.0  # the outer wall's face is the maze's edge
-    place(env, 0.0, face - 48 * base.MAP_UNIT, math.radians(90 - 70))
-    along = np.diff(push(env, FORWARD, 7)[3::4, 0]) / base.MAP_UNIT  # per step, from the first step's end
+    place(env, 0.0, face - 48 * doom.MAP_UNIT, math.radians(90 - 70))
+    along = np.diff(push(env, FORWARD, 7)[3::4, 0]) / doom.MAP_UNIT  # per step, from the first step's end
     assert along[3] == pytest.approx(26.0, rel=0.05)  # not yet at the wall
     assert along[4] < 0.75 * along[3]
     assert along[4] == pytest.approx(14.3, rel=0.25)

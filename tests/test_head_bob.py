@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from mjmaze import look, mjcf
+from mjmaze import doom, look, mjcf
 from mjmaze.tasks import base, two_colour
 
 # Actions as ViZDoom played them: forward 12 steps, nothing 8, forward 15, nothing 10.
@@ -43,14 +43,14 @@ def open_room(head_bob=None, width=320, height=180):
     env = base.make_environment(task)
     env.reset()
     # ViZDoom's start was (0, -500) facing 90 in the same room without the totem (at the centre here).
-    env.physics.set_agent_pose(1.5, -500 * mjcf.MAP_UNIT, math.pi / 2)
+    env.physics.set_agent_pose(1.5, -500 * doom.MAP_UNIT, math.pi / 2)
     return env
 
 
 def eye_units(env):
     """The eye's height above its rest in map units (mjmaze's rest: 0.32 m, 40.96 units; Doom's: 41)."""
     env.task.get_observation(env.physics)  # puts the eye where the view is
-    return env.physics.named.data.cam_xpos[base.CAMERA][2] / mjcf.MAP_UNIT - mjcf.EYE_HEIGHT / mjcf.MAP_UNIT
+    return env.physics.named.data.cam_xpos[base.CAMERA][2] / doom.MAP_UNIT - mjcf.EYE_HEIGHT / doom.MAP_UNIT
 
 
 def pistol_corner(env):
@@ -74,9 +74,9 @@ def test_walking_swings_the_eye_and_sways_the_pistol_as_vizdoom():
         if k >= 2:
             eyes.append(eye_units(env))
             corners.append(pistol_corner(env))
-    doom = np.array(VIZDOOM, dtype=float)
-    assert np.abs(np.array(eyes) - (doom[:, 0] - 41.0)).max() < 0.75  # map units (the eye swings 33..49)
-    assert np.abs(np.array(corners) - doom[:, 1:]).max() <= 1  # pixels at 320x180 (it sways 14 down, +-10 across)
+    measured = np.array(VIZDOOM, dtype=float)
+    assert np.abs(np.array(eyes) - (measured[:, 0] - 41.0)).max() < 0.75  # map units (the eye swings 33..49)
+    assert np.abs(np.array(corners) - measured[:, 1:]).max() <= 1  # pixels at 320x180 (it sways 14 down, +-10 across)
     env.task.close()
 
 
@@ -84,7 +84,7 @@ def step_still(env):
     """One step with no key held (the default action set has none: hold the physics' command at rest)."""
     task, physics = env.task, env.physics
     physics.command = (0, 0)
-    physics.step(base.TICS_PER_STEP)
+    physics.step(doom.TICS_PER_STEP)
     task.after_step(physics)
 
 
@@ -106,7 +106,7 @@ def test_walking_into_a_wall_stops_the_bob():
     # ViZDoom, from (0, 400) facing the north wall and holding forward: the eye reaches 49 at tic 46,
     # then the wall stops the player (y 624) and the eye stays within 0.1 unit of 41 (velocity 0).
     env = open_room(width=112, height=64)
-    env.physics.set_agent_pose(1.5, 400 * mjcf.MAP_UNIT, math.pi / 2)
+    env.physics.set_agent_pose(1.5, 400 * doom.MAP_UNIT, math.pi / 2)
     eyes, ys = [], []
     for _ in range(18):
         env.step(FORWARD)

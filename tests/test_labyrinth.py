@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import mjmaze
+from mjmaze import doom
 from mjmaze.tasks import base, labyrinth
 
 from conftest import FORWARD, TURN_LEFT, TURN_RIGHT, find_cell, place
@@ -69,7 +70,7 @@ def _steps(env, actions):
     for action in actions:
         env.step(action)
         nx, ny, nyaw = env.physics.agent_pose()
-        moved.append((math.hypot(nx - x, ny - y) / base.MAP_UNIT, math.degrees(math.remainder(nyaw - yaw, math.tau))))
+        moved.append((math.hypot(nx - x, ny - y) / doom.MAP_UNIT, math.degrees(math.remainder(nyaw - yaw, math.tau))))
         x, y, yaw = nx, ny, nyaw
     return np.array(moved)
 
@@ -78,7 +79,7 @@ def test_forward_gathers_speed_and_coasts_as_in_vizdoom(open_arena):
     moved = _steps(open_arena, [FORWARD] * 12 + [TURN_LEFT] * 6)
     assert moved[:, 0] == pytest.approx(DOOM_FORWARD_FROM_REST + DOOM_COASTING, abs=0.15)
     # Full speed: about a quarter metre per step.
-    assert base.FORWARD_PER_STEP == pytest.approx(33.4 * base.MAP_UNIT, abs=0.001)
+    assert base.FORWARD_PER_STEP == pytest.approx(33.4 * doom.MAP_UNIT, abs=0.001)
 
 
 def test_a_turn_starts_slow_as_in_vizdoom(open_arena):
@@ -94,7 +95,7 @@ def test_momentum_carries_the_agent_on_after_a_turn(open_arena):
     x, y, yaw = open_arena.physics.agent_pose()
     assert yaw == pytest.approx(math.radians(7.0 + 12.3 + 14.1 * 4), abs=0.01)
     assert y == pytest.approx(-3.0, abs=1e-6)  # it kept sliding along +x while it turned
-    assert moved[8:, 0].sum() > 0.5 / base.MAP_UNIT
+    assert moved[8:, 0].sum() > 0.5 / doom.MAP_UNIT
 
 
 def _walled_cell(config):

@@ -15,7 +15,8 @@ import pytest
 
 import mjmaze
 
-from mjmaze import compiled_light, core, look, mjcf, palette, render, sprites, viz
+from mjmaze import compiled_light, look, mjcf, palette, render, sprites, viz
+from mjmaze.doom import FIRST_OBSERVATION_TIC
 from mjmaze.group import EnvGroup
 from mjmaze.tasks import base, find_return, k_item, labyrinth, two_colour
 
@@ -236,7 +237,7 @@ def test_the_armour_blinks_as_dooms_a_sector_lit_picture_then_a_fullbright_one()
     env.physics.place_objects(env.physics.object_ids(["item_0"])[0], np.array([[1.0, 0.3]]))
     brightness = np.array([object_colour_at_step(env, step).sum() for step in range(13)])
     env.task.close()
-    tics = (core.FIRST_OBSERVATION_TIC + 4 * np.arange(13)) % 13
+    tics = (FIRST_OBSERVATION_TIC + 4 * np.arange(13)) % 13
     lit, bright = brightness[tics < 6], brightness[tics >= 6]
     assert np.ptp(lit) < 0.02 * lit.mean() and np.ptp(bright) < 0.02 * bright.mean()  # one picture each
     assert bright.mean() > 1.3 * lit.mean()

@@ -10,8 +10,7 @@ import pytest
 from conftest import find_cell, open_run, place
 
 import mjmaze
-from mjmaze import maze, play, viz
-from mjmaze.tasks import base
+from mjmaze import doom, maze, play, viz
 
 
 @pytest.fixture
@@ -147,7 +146,7 @@ def test_headless_replay_moves_the_agent_and_writes_the_session(tmp_path):
         place(replayed.env, *config.cell_centre(cell), 0.0)
         before = replayed.env.physics.agent_pose()
         play.replay(replayed, ["w"])
-        assert replayed.poses[-1][0] - before[0] == pytest.approx(7.1 * base.MAP_UNIT, abs=0.005)  # one step from rest
+        assert replayed.poses[-1][0] - before[0] == pytest.approx(7.1 * doom.MAP_UNIT, abs=0.005)  # one step from rest
     finally:
         replayed.close()
 

@@ -19,7 +19,7 @@ import pathlib
 import tempfile
 
 import mjmaze
-from mjmaze.tasks import base
+from mjmaze import doom
 
 # Key sequences as indices of the default action set: 0 left, 1 right, 2 forward, 3 forward+left.
 SEQUENCES = {
@@ -67,7 +67,7 @@ def mjmaze_steps(actions: list[int]) -> list[tuple[float, float]]:
         env.step(action)
         new = env.physics.agent_pose()
         turn = math.degrees(math.remainder(new[2] - pose[2], math.tau))
-        steps.append((math.hypot(new[0] - pose[0], new[1] - pose[1]) / base.MAP_UNIT, turn))
+        steps.append((math.hypot(new[0] - pose[0], new[1] - pose[1]) / doom.MAP_UNIT, turn))
         pose = new
     env.task.close()
     return steps
@@ -92,22 +92,22 @@ def wall_slide(angles=(20, 45, 70), steps: int = 12) -> None:
             doom_frames.write_wad(wad, doom_frames.textmap(config, (x0, y0, heading), [], doom_frames.STONE))
             game = doom_frames.released_game(wad, weapon=False,
                                              variables=[vzd.GameVariable.POSITION_X, vzd.GameVariable.POSITION_Y])
-            doom = []
+            vizdoom_path = []
             for _ in range(steps):
                 game.make_action([True], 4)
-                doom.append((game.get_game_variable(vzd.GameVariable.POSITION_X),
+                vizdoom_path.append((game.get_game_variable(vzd.GameVariable.POSITION_X),
                              game.get_game_variable(vzd.GameVariable.POSITION_Y)))
             game.close()
         env.reset()
         physics.show_objects(physics.object_ids([o.name for o in env.task.objects])[1], False)
-        physics.set_agent_pose(x0 * base.MAP_UNIT, y0 * base.MAP_UNIT, math.radians(heading))
+        physics.set_agent_pose(x0 * doom.MAP_UNIT, y0 * doom.MAP_UNIT, math.radians(heading))
         ours = []
         for _ in range(steps):
             env.step(2)  # forward
             x, y, _ = physics.agent_pose()
-            ours.append((x / base.MAP_UNIT, y / base.MAP_UNIT))
+            ours.append((x / doom.MAP_UNIT, y / doom.MAP_UNIT))
         print(f"forward into a wall, {angle} degrees from its normal")
-        for label, path in (("  ViZDoom", doom), ("  mjmaze ", ours)):
+        for label, path in (("  ViZDoom", vizdoom_path), ("  mjmaze ", ours)):
             xs = [x0] + [x for x, _ in path]
             print(label, "along:", " ".join(f"{b - a:5.1f}" for a, b in zip(xs, xs[1:])),
                   f"| stopped {path[-1][1] - y0:.1f} units toward it")

@@ -50,7 +50,8 @@ import urllib.request
 import numpy as np
 import torch
 
-from mjmaze import core, files, mjcf, rules, sprites, suite
+from mjmaze import files, rules, sprites, suite
+from mjmaze.doom import FIRST_OBSERVATION_TIC, MAP_UNIT, TICS_PER_STEP
 from mjmaze.train import paper_agents
 
 LIMITED_ACTIONS = ([True, False, False, False], [False, True, False, False], [False, False, True, False],
@@ -327,7 +328,7 @@ def motion(name: str, checkout: str, mazes: int = 8, wad: str | None = None) -> 
     folder = pathlib.Path(checkout) / paper_agents.MAZES / info.maze_folder / "test"
     env = mjmaze.load(info.scenario, task_kwargs={**info.task_kwargs, "layouts": str(folder), "head_bob": False})
     task, physics = env.task, env.physics
-    per_tic = mjcf.MAP_UNIT / physics.model.opt.timestep  # map units a tic -> m/s
+    per_tic = MAP_UNIT / physics.model.opt.timestep  # map units a tic -> m/s
     rows = []
     for index in range(mazes):
         centre = _maze_centre(folder, index)
@@ -354,9 +355,9 @@ def motion(name: str, checkout: str, mazes: int = 8, wad: str | None = None) -> 
             physics.command = task.actions[action]
             physics.step(FRAME_SKIP)
             held = (held + FRAME_SKIP) * (task.actions[action][1] != 0)
-            ours = np.array(physics.agent_pose()[:2]) / mjcf.MAP_UNIT
-            start_xy = np.array(_metres(x, y, centre)) / mjcf.MAP_UNIT
-            doom = np.array(_metres(next_x, next_y, centre)) / mjcf.MAP_UNIT
+            ours = np.array(physics.agent_pose()[:2]) / MAP_UNIT
+            start_xy = np.array(_metres(x, y, centre)) / MAP_UNIT
+            doom = np.array(_metres(next_x, next_y, centre)) / MAP_UNIT
             rows.append((np.hypot(*(ours - doom)), np.hypot(*(doom - start_xy)), np.hypot(*(ours - start_xy))))
     task.close()
     return np.array(rows)
@@ -375,7 +376,7 @@ def _teleport(game, x: float, y: float, yaw: float, centre: np.ndarray):
 
     if game.is_episode_finished() or game.get_episode_time() > 1800:
         game.new_episode()
-    game.send_game_command(f"warp {x / mjcf.MAP_UNIT + centre[0]:.3f} {y / mjcf.MAP_UNIT + centre[1]:.3f}")
+    game.send_game_command(f"warp {x / MAP_UNIT + centre[0]:.3f} {y / MAP_UNIT + centre[1]:.3f}")
     game.make_action([0] * 5, 1)  # the warp takes effect on the next tic
     angle = game.get_game_variable(vzd.GameVariable.ANGLE)
     game.make_action([0, 0, 0, 0, angle - math.degrees(yaw) % 360], 1)  # the delta turns clockwise
@@ -657,7 +658,7 @@ def blink(name: str, checkout: str, mazes: int = 8, steps: int = 300, wad: str |
                 if sprite is None or drawn.sum() < 15:
                     continue
                 depth = ((label.object_position_x - player.position_x) * math.cos(yaw)
-                         + (label.object_position_y - player.position_y) * math.sin(yaw)) * mjcf.MAP_UNIT
+                         + (label.object_position_y - player.position_y) * math.sin(yaw)) * MAP_UNIT
                 if not 0.8 <= depth <= 5.0:
                     continue
                 colour = state.screen_buffer.transpose(1, 2, 0)[drawn].astype(np.float64).mean(axis=0)
@@ -681,7 +682,7 @@ def blink(name: str, checkout: str, mazes: int = 8, steps: int = 300, wad: str |
             if timestep.last():
                 break
             ids, visible = np.unique(task.segmentation(physics), return_counts=True)
-            clock = core.FIRST_OBSERVATION_TIC + task.steps * core.TICS_PER_STEP
+            clock = FIRST_OBSERVATION_TIC + task.steps * TICS_PER_STEP
             for geom, pixels in zip(ids.tolist(), visible.tolist()):
                 if geom in by_geom and pixels >= 2:  # 15 of 320x180's pixels are ~2 of 112x64's
                     doom, k = by_geom[geom]
@@ -706,7 +707,7 @@ def _reset_to(env, index: int) -> None:
 
 def _metres(x: float, y: float, centre: np.ndarray) -> tuple[float, float]:
     """A Doom map point in mjmaze's metres (mjmaze centres the maze on (0, 0))."""
-    return (x - centre[0]) * mjcf.MAP_UNIT, (y - centre[1]) * mjcf.MAP_UNIT
+    return (x - centre[0]) * MAP_UNIT, (y - centre[1]) * MAP_UNIT
 
 
 def _two_colour_things(game, centre: np.ndarray) -> tuple[list, bool | None]:

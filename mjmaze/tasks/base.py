@@ -19,15 +19,14 @@ from dm_control.rl import control
 from dm_control.suite import base
 from dm_env import specs
 
-from mjmaze import configs, core, mjcf, rules
+from mjmaze import configs, core, doom, mjcf, rules
 from mjmaze.group import EnvGroup
 # The timing, motion and action names scenario code and tests read as base.*.
 from mjmaze.core import (  # noqa: F401
-    ACTION_NAMES, ACTION_SETS, AGENT_RADIUS, DEFAULT_HEIGHT, DEFAULT_WIDTH, EPISODE_STEPS, PICKUP_RADIUS,
-    STEPS_PER_SECOND, TICS_PER_SECOND, TICS_PER_STEP,
+    ACTION_NAMES, ACTION_SETS, AGENT_RADIUS, DEFAULT_HEIGHT, DEFAULT_WIDTH, EPISODE_STEPS, STEPS_PER_SECOND,
 )
 from mjmaze.physics import (  # noqa: F401
-    FORWARD_PER_STEP, FRICTION, MAP_UNIT, SLOW_TURN_TICS, THRUST_PER_TIC, TURN_PER_STEP, TURN_PER_TIC, VISIBLE_GROUP,
+    FORWARD_PER_STEP, FRICTION, SLOW_TURN_TICS, THRUST_PER_TIC, TURN_PER_STEP, TURN_PER_TIC, VISIBLE_GROUP,
     MazePhysics, tic_motion,
 )
 
@@ -190,6 +189,6 @@ def make_physics(rules: core.MazeRules, count: int = 1) -> list[MazePhysics]:
 def make_environment(task: MazeTask, environment_kwargs: dict | None = None) -> control.Environment:
     """Compiles the task's arena and wraps it in a dm_control environment."""
     physics = make_physics(task)[0]
-    kwargs = dict(n_sub_steps=TICS_PER_STEP, legacy_step=False)
+    kwargs = dict(n_sub_steps=doom.TICS_PER_STEP, legacy_step=False)
     kwargs.update(environment_kwargs or {})
     return control.Environment(physics, task, **kwargs)

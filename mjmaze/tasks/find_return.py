@@ -9,7 +9,7 @@ Rewards
     the green pillar (the return); -0.0001 per tic (-0.0004 per agent step).
     As released, the target and return items are invisible and sit on the
     pillars: the pillars are the only cues. Touching = Doom's pick-up test after
-    any tic: the agent's centre within ``rules.PICKUP_RADIUS`` (36 map units,
+    any tic: the agent's centre within ``doom.PICKUP_RADIUS`` (36 map units,
     0.28 m) of the pillar's centre in x and in y (the agent is stopped at 0.25 m).
 Termination
     The return collected (discount 0) or 525 agent steps (discount 1).
@@ -23,7 +23,7 @@ Version History
 
 from __future__ import annotations
 
-from mjmaze import configs, core, maze, mjcf, palette, registry, rules, versions
+from mjmaze import configs, core, doom, maze, mjcf, palette, registry, rules, versions
 
 if __doc__:  # python -OO drops docstrings
     __doc__ += versions.version_history(versions.FIND_RETURN)
@@ -35,11 +35,11 @@ DEFAULT_SIZE = 9
 CELL_SIZE = 1.0
 TARGET_REWARD = 0.5
 RETURN_REWARD = 0.5
-STEP_REWARD = -0.0001 * core.TICS_PER_STEP
+STEP_REWARD = -0.0001 * doom.TICS_PER_STEP
 # Doom's tall green and red columns (things 30 and 32), as released: 16 map
 # units in radius, 52 high.
-PILLAR_RADIUS = 16 * mjcf.MAP_UNIT
-PILLAR_HEIGHT = 52 * mjcf.MAP_UNIT
+PILLAR_RADIUS = 16 * doom.MAP_UNIT
+PILLAR_HEIGHT = 52 * doom.MAP_UNIT
 # The agent spawns this far off the green pillar in -x and -y.
 SPAWN_OFFSET = 0.25
 

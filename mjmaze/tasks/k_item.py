@@ -27,7 +27,7 @@ Version History
 
 from __future__ import annotations
 
-from mjmaze import configs, core, maze, mjcf, registry, rules, sprites, versions
+from mjmaze import configs, core, doom, maze, mjcf, registry, rules, sprites, versions
 
 if __doc__:  # python -OO drops docstrings
     __doc__ += versions.version_history(versions.K_ITEM)
@@ -41,7 +41,7 @@ SIZES = tuple(range(2, 14))
 CELL_SIZE = 1.25
 NEXT_ITEM_REWARD = 0.5
 WRONG_ITEM_REWARD = -0.25
-STEP_REWARD = -0.0001 * core.TICS_PER_STEP
+STEP_REWARD = -0.0001 * doom.TICS_PER_STEP
 
 
 # Item kinds in collection order: (colour code in the released files, geom),

@@ -22,7 +22,7 @@ Version History
 
 from __future__ import annotations
 
-from mjmaze import configs, core, maze, mjcf, registry, rules, sprites, versions
+from mjmaze import configs, core, doom, maze, mjcf, registry, rules, sprites, versions
 
 if __doc__:  # python -OO drops docstrings
     __doc__ += versions.version_history(versions.LABYRINTH)
@@ -33,7 +33,7 @@ PAPER_SIZES = (7, 9, 11, 13)
 DEFAULT_SIZE = 9
 CELL_SIZE = 1.0
 EXIT_REWARD = 1.0
-STEP_REWARD = -0.0001 * core.TICS_PER_STEP
+STEP_REWARD = -0.0001 * doom.TICS_PER_STEP
 
 # The released mazes' exit is Doom's green armour (thing 2018): a pickup lying
 # on the floor, drawn as Freedoom's picture (31 x 18 map units). How small it

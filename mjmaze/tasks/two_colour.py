@@ -44,7 +44,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mjmaze import configs, core, mjcf, palette, registry, rules, sprites, versions, walls
+from mjmaze import configs, core, doom, mjcf, palette, registry, rules, sprites, versions, walls
 
 if __doc__:  # python -OO drops docstrings
     __doc__ += versions.version_history(versions.TWO_COLOUR)
@@ -61,7 +61,7 @@ SPAWN_EVERY_TICS = 30
 # green first: 11 green and 10 red at the first observation, the next (red) at tic 30
 # (measured in ViZDoom: docs/notes/scenarios.md, "Two-colour's items").
 START_ITEMS = 2 * START_ITEMS_PER_COLOUR + 1
-POOL_SIZE = START_ITEMS + (core.EPISODE_STEPS * core.TICS_PER_STEP) // SPAWN_EVERY_TICS  # 91
+POOL_SIZE = START_ITEMS + (core.EPISODE_STEPS * doom.TICS_PER_STEP) // SPAWN_EVERY_TICS  # 91
 MAX_HEALTH = 100
 ITEM_HEALTH = 25
 # The released script hands over the armour first, then takes 25 with
@@ -81,12 +81,12 @@ LAVA_DAMAGE = 8
 LAVA_EVERY_TICS = 32
 LAVA_FIRST_TIC = 23
 START_HEALTH = MAX_HEALTH - LAVA_DAMAGE
-SURVIVAL_REWARD = 0.01 * core.TICS_PER_STEP
+SURVIVAL_REWARD = 0.01 * doom.TICS_PER_STEP
 CORRECT_ITEM_REWARD = 1.0
 # Items appear uniformly where the released script's Spawn succeeds (it retries
 # until one does): the armour's square (Doom's radius 20 map units) clear of
 # every wall and of the solid totem's and agent's squares (so out of reach).
-ITEM_RADIUS = 20 * mjcf.MAP_UNIT
+ITEM_RADIUS = 20 * doom.MAP_UNIT
 # Points tried per item, the first free one kept (see TwoColour._free_positions):
 # a point lands on free floor with probability >= 0.79 (complexity 10, the
 # most walls, measured over generated mazes), so all 32 miss with probability
@@ -111,7 +111,7 @@ TOTEM_CLEARANCE = TOTEM_RADIUS + core.AGENT_RADIUS
 ITEM_TOTEM_CLEARANCE = TOTEM_RADIUS + ITEM_RADIUS
 # Where the released map keeps the columns until its script moves one in
 # (4,096 map units west of the centre), and an absent totem stays.
-TOTEM_PARKED_XY = (-4096 * mjcf.MAP_UNIT, 0.0)
+TOTEM_PARKED_XY = (-4096 * doom.MAP_UNIT, 0.0)
 ITEMS = tuple(mjcf.sprite_thing(f"item_{k}", sprites.GREEN_ARMOUR if k % 2 == 0 else sprites.BLUE_ARMOUR)
               for k in range(POOL_SIZE))
 TOTEM_COLOURS = (tuple(RED), tuple(GREEN))  # by totem_green
@@ -203,7 +203,7 @@ class TwoColour(core.MazeRules):
         # The step's events, in the order Doom takes them: by tic, and within a
         # tic the floor's hit before the items (by index). Health is capped,
         # so the order matters. Event 0 is the lava, event 1 + k item k.
-        before = (state["steps"] - 1) * core.TICS_PER_STEP  # tics played before this step
+        before = (state["steps"] - 1) * doom.TICS_PER_STEP  # tics played before this step
         lava_tic = (LAVA_FIRST_TIC - 1 - before) % LAVA_EVERY_TICS  # this step's tic index of the next hit
         event_tic = xp.concat([xp.where(lava_tic < tics, lava_tic, -1)[:, None], first_tic], axis=1)
         index = xp.arange(1 + POOL_SIZE, dtype=xp.int64, device=device)
@@ -238,7 +238,7 @@ class TwoColour(core.MazeRules):
         state["health"] = health
         shown = xp.concat([shown[:, :1], shown[:, 1:] & ~picked], axis=1)
         # One item every 30 tics (never more than one per 4-tic step after the start).
-        due = rules.at_most(xp, START_ITEMS + state["steps"] * core.TICS_PER_STEP // SPAWN_EVERY_TICS, self._item_cap)
+        due = rules.at_most(xp, START_ITEMS + state["steps"] * doom.TICS_PER_STEP // SPAWN_EVERY_TICS, self._item_cap)
         spawn = ~dead & (state["items_spawned"] < due)
         # On numpy most steps spawn nothing: skip the draws then. On torch, draw
         # for every env and keep the spawns (asking whether any is due would wait for the GPU).
@@ -280,7 +280,7 @@ class TwoColour(core.MazeRules):
             free = (
                 (xp.min(xp.maximum(gap_x, gap_y), axis=-1) >= ITEM_RADIUS)
                 & (xp.max(xp.abs(points - totem_xy), axis=-1) >= ITEM_TOTEM_CLEARANCE)
-                & (xp.max(xp.abs(points - agent_xy[:, None, None, :]), axis=-1) >= core.PICKUP_RADIUS)
+                & (xp.max(xp.abs(points - agent_xy[:, None, None, :]), axis=-1) >= doom.PICKUP_RADIUS)
             )
             first = candidate[..., 0] == xp.argmax(xp.astype(free, xp.int8), axis=-1)[..., None]  # (B, k, candidates)
             xys.append(xp.sum(points * xp.astype(first, xp.float64)[..., None], axis=2))
@@ -289,7 +289,7 @@ class TwoColour(core.MazeRules):
 
     def episode_metrics(self, state):
         return {
-            "duration": state["steps"] * core.TICS_PER_STEP,
+            "duration": state["steps"] * doom.TICS_PER_STEP,
             "health": state["health"],
             "totem_green": state["totem_green"],
         }
