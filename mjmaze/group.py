@@ -27,7 +27,8 @@ class EnvGroup:
 
     Args:
       rules: the scenario's core (:class:`mjmaze.core.MazeRules`), shared by every row.
-      physics: each env's physics, built from the scenario's arena (:func:`mjmaze.tasks.base.make_physics`).
+      physics: each env's physics, built from the scenario's arena with its projection
+        (:func:`mjmaze.tasks.base.make_physics`).
       seed_keys: each env's key for its episodes' draws (:func:`mjmaze.rules.seed_key`).
       first_configs: where each env starts cycling through the configurations (default: the rules').
     """
@@ -48,8 +49,6 @@ class EnvGroup:
         models = [p.model.ptr for p in self.physics]
         self._models, self._data = models, [p.data.ptr for p in self.physics]
         self._qpos = [data.qpos for data in self._data]
-        for model in models:
-            mjcf.set_ego_projection(model, rules.width, rules.height)
         self._walls = [walls.WallLayout(model, rules.layout.grid_size, rules.layout.cell_size) for model in models]
         self.pipeline = look.FramePipeline(np, "cpu", rules, models[0])
         self.renderers: list[render.EgoRenderer] = []

@@ -48,7 +48,6 @@ from gymnasium.vector import AutoresetMode
 
 from mjmaze import batch, registry, suite
 from mjmaze.group import EnvGroup
-from mjmaze.rules import seed_key
 from mjmaze.tasks import base
 
 SHARED_MEMORY_PREFIX = "mjmaze_"
@@ -116,15 +115,15 @@ class _SharedGroup:
         self._slots = np.array(slots)
         rules = suite.make_rules(scenario, task_kwargs)
         # Unseeded envs draw their keys as a dm_control task with random=None does.
-        keys = [seed_key(np.random.RandomState()) for _ in slots]
+        keys = batch.seed_keys([None] * len(slots))
         self._group = EnvGroup(rules, base.make_physics(rules, len(slots)), keys, first_configs)
         self._ended = np.zeros(len(slots), dtype=bool)  # next-step mode: the env resets on its next step
 
     def reset(self, seeds: list[int] | None) -> None:
         group = self._group
         if seeds is not None:
-            for row, slot in enumerate(self._slots):
-                group.reseed(row, seed_key(np.random.RandomState(seeds[slot])))
+            for row, key in enumerate(batch.seed_keys([seeds[slot] for slot in self._slots])):
+                group.reseed(row, int(key))
         self._restart(list(range(len(group))))
 
     def _restart(self, rows: list[int]) -> None:

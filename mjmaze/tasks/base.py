@@ -31,8 +31,6 @@ from mjmaze.physics import (  # noqa: F401
 )
 
 CAMERA = mjcf.EGO_CAMERA
-# Scenarios written against MazeTask before mjmaze.core existed check their arguments with this.
-_check_choice = core.check_choice
 
 
 class MazeTask(core.MazeRules, base.Task):
@@ -166,22 +164,22 @@ class MazeTask(core.MazeRules, base.Task):
 
 @functools.cache
 def task_class(rules_class: type) -> type:
-    """The dm_control task class of a scenario: ``rules_class`` itself if it is a :class:`MazeTask`,
-    else ``rules_class`` joined with :class:`MazeTask` (cached: one class per scenario)."""
-    if issubclass(rules_class, MazeTask):
-        return rules_class
+    """The dm_control task class of a scenario: ``rules_class`` joined with :class:`MazeTask` (cached: one
+    class per scenario)."""
     return type(f"{rules_class.__name__}Task", (rules_class, MazeTask), {"__module__": rules_class.__module__,
                                                                "__doc__": rules_class.__doc__})
 
 
 def make_physics(rules: core.MazeRules, count: int = 1) -> list[MazePhysics]:
-    """``count`` physics of the scenario's arena (its model built once, compiled for each)."""
+    """``count`` physics of the scenario's arena (its model built once, compiled for each), the camera's
+    projection final."""
     xml = mjcf.build_xml(rules.layout.grid_size, rules.layout.cell_size, rules.objects, rules.visual_style,
                          rules.room, width=rules.width)
     made = []
     for _ in range(count):
         physics = MazePhysics.from_xml_string(xml)
         mjcf.paint_textures(physics.model.ptr, rules.room, rules.objects, rules.width, rules.layout.cell_size)
+        mjcf.set_ego_projection(physics.model.ptr, rules.width, rules.height)
         made.append(physics)
     return made
 
