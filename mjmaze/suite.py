@@ -65,12 +65,19 @@ def task_kwarg_names(name: str) -> tuple[str, ...]:
     return _parameters(registry.get(name).task.__init__) + _parameters(core.MazeRules.__init__) + ("random",)
 
 
+class UnknownArgumentError(TypeError, ValueError):
+    """A task argument the scenario does not take. A ``TypeError``, as Python's own for an unexpected
+    keyword (libraries that try an optional keyword catch it: TorchRL's ``GymEnv`` tries ``frameskip``),
+    and a ``ValueError``, as mjmaze's other argument errors."""
+
+
 def _checked(name: str, task_kwargs: dict | None) -> dict:
     task_kwargs = dict(task_kwargs or {})
     valid = task_kwarg_names(name)
     unknown = sorted(set(task_kwargs) - set(valid))
     if unknown:
-        raise ValueError(f"unknown task argument(s) {unknown} for {name!r}; valid: {valid}")
+        raise UnknownArgumentError(f"{name!r} got an unexpected keyword argument {', '.join(map(repr, unknown))}; "
+                                   f"valid: {valid}")
     return task_kwargs
 
 
