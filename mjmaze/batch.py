@@ -48,6 +48,17 @@ def seed_keys(seeds: Sequence[int]) -> np.ndarray:
     return np.array([rules.seed_key(np.random.RandomState(s)) for s in seeds], dtype=np.int64)
 
 
+def check_actions(actions, num_envs: int, num_actions: int) -> np.ndarray:
+    """``actions`` as an int64 ``(num_envs,)`` array, or one ``ValueError`` naming what is valid: an
+    integer in ``0..num_actions - 1`` per env (no floats, bools or strings; nothing rounded)."""
+    values = np.asarray(actions)
+    if (values.shape != (num_envs,) or values.dtype.kind not in "iu"
+            or values.min(initial=0) < 0 or values.max(initial=0) >= num_actions):
+        raise ValueError(f"actions are {num_envs} integers in 0..{num_actions - 1}, one per env; got "
+                         f"{np.array2string(values, threshold=8)} (shape {values.shape}, dtype {values.dtype})")
+    return values.astype(np.int64, copy=False)
+
+
 def first_configs(first: int, num_envs: int, num_configs: int) -> list[int]:
     """Where each env starts cycling through the configurations: spread evenly from ``first``.
 

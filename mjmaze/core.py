@@ -274,6 +274,16 @@ def imported_configs(folder, scenario: str, layout: configs.LayoutSpec, num_conf
     return loaded[:num_configs] if num_configs else loaded
 
 
+def check_action(action, num_actions: int) -> int:
+    """``action`` as an ``int``, or one ``ValueError`` naming the valid range. An action is an integer
+    (Python's, numpy's, or a one-element integer array); a float, a bool or a string is refused, not
+    rounded or read, and the env is left as it was."""
+    value = np.asarray(action)
+    if value.size != 1 or value.dtype.kind not in "iu" or not 0 <= int(value.reshape(())) < num_actions:
+        raise ValueError(f"an action is an integer in 0..{num_actions - 1}, got {action!r}")
+    return int(value.reshape(()))
+
+
 def check_choice(name: str, value, valid: Sequence) -> None:
     if value not in valid:
         raise ValueError(f"{name} must be one of {tuple(valid)}, got {value!r}")

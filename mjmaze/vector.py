@@ -427,7 +427,7 @@ class MazeVectorEnv(batch.BatchEnv):
     def step(self, actions):
         self._check_usable()
         started = time.perf_counter()
-        self._arrays["actions"][:] = actions
+        self._arrays["actions"][:] = batch.check_actions(actions, self.num_envs, self.single_action_space.n)
         self._send_all("step", None)
         local_started = time.perf_counter()
         self._run_local("step", None)

@@ -244,6 +244,13 @@ class MazeBatchEnv(batch.BatchEnv):
         step's work without waiting for the last one to finish.
         """
         xp, task = self.xp, self.task
+        if isinstance(actions, torch.Tensor) and actions.device.type != "cpu":
+            # Checking a device tensor's values would wait for the device: its shape and type only.
+            if actions.shape != (self.num_envs,) or actions.dtype.is_floating_point or actions.dtype == torch.bool:
+                raise ValueError(f"actions are {self.num_envs} integers in 0..{self.single_action_space.n - 1}, "
+                                 f"one per env; got a {actions.dtype} tensor of shape {tuple(actions.shape)}")
+        else:
+            actions = batch.check_actions(actions, self.num_envs, self.single_action_space.n)
         actions = torch.as_tensor(actions, device=self.device).long()
         ended_before = self._ended
         with self._warp_stream():

@@ -9,6 +9,7 @@ from gymnasium.utils.env_checker import check_env
 
 import mjmaze
 from mjmaze.tasks import find_return, k_item, labyrinth, two_colour
+from mjmaze.vector import MazeVectorEnv
 
 
 @pytest.fixture(params=mjmaze.ALL_TASKS)
@@ -163,3 +164,33 @@ def test_the_cpu_envs_import_neither_warp_nor_torch():
     )
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert result.stdout.strip().splitlines()[-1] == "[]"
+
+
+@pytest.mark.parametrize("bad", [5, -1, 2.5, "2", True, np.array([1, 2]), None])
+def test_a_bad_action_is_one_clear_error_and_the_env_goes_on_as_if_it_never_came(bad):
+    env, twin = (gymnasium.make(mjmaze.GYM_IDS["labyrinth"], size=5) for _ in range(2))
+    env.reset(seed=0)
+    twin.reset(seed=0)
+    with pytest.raises(ValueError, match=r"an action is an integer in 0\.\.4, got"):
+        env.step(bad)
+    for action in (2, np.int64(3), np.array(1)):  # Python's, numpy's, a 0-d array
+        obs, reward, terminated, truncated, info = env.step(action)
+        expected = twin.step(int(action))
+        assert np.array_equal(obs, expected[0]) and (reward, terminated, truncated, info) == expected[1:]
+    env.close()
+    twin.close()
+
+
+@pytest.mark.parametrize("bad", [[0, 5], [0, -1], [0.0, 1.0], [True, False], [0, 1, 2], ["0", "1"]])
+def test_a_vector_env_refuses_bad_actions_with_one_clear_error(bad):
+    envs = MazeVectorEnv(2, "labyrinth", num_workers=0, size=5)
+    twin = MazeVectorEnv(2, "labyrinth", num_workers=0, size=5)
+    envs.reset(seed=0)
+    twin.reset(seed=0)
+    with pytest.raises(ValueError, match=r"actions are 2 integers in 0\.\.4, one per env"):
+        envs.step(np.array(bad))
+    obs, *rest = envs.step([2, 3])
+    expected = twin.step(np.array([2, 3]))
+    assert np.array_equal(obs, expected[0]) and all(np.array_equal(a, b) for a, b in zip(rest[:3], expected[1:4]))
+    envs.close()
+    twin.close()

@@ -274,6 +274,18 @@ def test_reached_through_gymnasium_by_one_word():
         gymnasium.make_vec(mjmaze.GYM_IDS["k_item"], num_envs=2, vectorization_mode="vector_entry_point", backend="tpu")
 
 
+def test_bad_actions_are_one_clear_error_and_change_nothing():
+    batch, twin = (mjwarp.MazeBatchEnv(2, "labyrinth", device="cpu", render=False, size=5) for _ in range(2))
+    batch.reset(seed=0)
+    twin.reset(seed=0)
+    for bad in ([0, 5], [0, -1], [0.0, 1.0], [0, 1, 2], torch.tensor([0.0, 1.0])):
+        with pytest.raises(ValueError, match=r"actions are 2 integers in 0\.\.4, one per env"):
+            batch.step(bad)
+    _, reward, terminated, truncated, info = batch.step(torch.tensor([2, 3]))
+    expected = twin.step(np.array([2, 3]))
+    assert torch.equal(reward, expected[1]) and torch.equal(info["x"], expected[4]["x"])
+
+
 def test_bad_arguments_say_what_to_do():
     with pytest.raises(ValueError, match="autoreset_mode"):
         mjwarp.MazeBatchEnv(2, "labyrinth", device="cpu", autoreset_mode="never")

@@ -92,7 +92,7 @@ class MazeTask(core.MazeRules, base.Task):
     # -- the per-step path ------------------------------------------------
 
     def before_step(self, action, physics: MazePhysics) -> None:
-        physics.command = self.actions[int(action)]
+        physics.command = self.actions[core.check_action(action, len(self.actions))]
 
     def after_step(self, physics: MazePhysics) -> None:
         reward, ended, _ = self._group.end_step([0])
