@@ -1,5 +1,6 @@
 """The shared-memory vector env: API, autoreset, seeding, failures and clean-up."""
 
+import dataclasses
 import os
 import signal
 import time
@@ -10,7 +11,30 @@ import pytest
 
 import mjmaze
 
+from mjmaze import registry, suite
+from mjmaze.tasks import labyrinth
 from mjmaze.vector import SHARED_MEMORY_PREFIX, MazeVectorEnv, WorkerError
+
+
+class FailingLabyrinth(labyrinth.Labyrinth):
+    """Labyrinth whose rules raise on an episode's second step: an exception inside a task (a worker
+    imports this module to build it)."""
+
+    def rules(self, xp, state, path):
+        if int(state["steps"].max()) >= 2:
+            raise RuntimeError("the rules failed on purpose")
+        return super().rules(xp, state, path)
+
+
+FAILING = dataclasses.replace(labyrinth.SCENARIO, name="failing_labyrinth", task=FailingLabyrinth,
+                              gym_id="mjmaze_test/FailingLabyrinth-v0", seed_code=1002)
+
+
+@pytest.fixture
+def failing(monkeypatch):
+    """:data:`FAILING` registered for one test only (every other test reads the registry)."""
+    monkeypatch.setattr(registry, "_SCENARIOS", dict(registry._SCENARIOS))
+    return suite.register(FAILING)
 
 TURN_LEFT = 0
 
@@ -143,11 +167,12 @@ def test_a_killed_worker_is_a_clear_error_not_a_hang():
 
 
 @pytest.mark.slow
-def test_an_exception_in_a_task_names_the_worker_and_the_error():
-    envs = MazeVectorEnv(2, "labyrinth", size=5, num_workers=2)
+def test_an_exception_in_a_task_names_the_worker_and_the_error(failing):
+    envs = MazeVectorEnv(2, failing.name, size=5, num_workers=2, step_in_caller=False)
     envs.reset(seed=0)
-    with pytest.raises(WorkerError, match=r"worker 0 .*IndexError"):
-        envs.step(np.array([7, 0]))  # no action 7 in the default set of 5
+    envs.step(np.array([2, 0]))
+    with pytest.raises(WorkerError, match=r"worker [01] .*RuntimeError: the rules failed on purpose"):
+        envs.step(np.array([2, 0]))
     assert not any(p.is_alive() for p in envs._processes)
 
 
@@ -229,11 +254,12 @@ def test_where_an_env_is_stepped_changes_nothing():
         assert np.array_equal(in_workers[0], other[0]) and np.array_equal(in_workers[1], other[1])
 
 
-def test_an_exception_in_the_callers_share_closes_the_vector_env():
-    envs = MazeVectorEnv(2, "labyrinth", size=5, num_workers=1)  # env 1 is stepped here
+def test_an_exception_in_the_callers_share_closes_the_vector_env(failing):
+    envs = MazeVectorEnv(2, failing.name, size=5, num_workers=1)  # env 1 is stepped here
     envs.reset(seed=0)
-    with pytest.raises(IndexError):
-        envs.step(np.array([0, 7]))  # no action 7 in the default set of 5
+    envs.step(np.array([0, 2]))
+    with pytest.raises(RuntimeError, match="on purpose"):  # this process's share fails first
+        envs.step(np.array([0, 2]))
     assert envs.closed and not any(p.is_alive() for p in envs._processes)
 
 
