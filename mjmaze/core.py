@@ -252,6 +252,12 @@ def _first_frame_tics(objects: tuple) -> tuple[int, ...]:
     return tuple(obj.sprite.frames[0][1] if obj.sprite is not None else 1 for obj in objects)
 
 
+def wrap_yaw(xp, yaw):
+    """Headings ``yaw`` (radians) wrapped into ``[-pi, pi]`` on numpy or torch (``xp``): the one wrap every
+    env's and backend's reported heading goes through."""
+    return yaw - math.tau * xp.round(yaw / math.tau)
+
+
 def episode_info(metrics: dict, x, y, yaw, step, episode_return, config_index) -> dict:
     """An env's ``info`` (Python scalars) or a batch's (``(B,)`` arrays): the scenario's metric
     fields, the agent's pose (yaw in ``(-pi, pi]``), the agent steps taken, the return so far

@@ -11,7 +11,6 @@ vector env (:class:`mjmaze.vector.MazeVectorEnv`) steps one group, its share.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -227,7 +226,7 @@ class EnvGroup:
         rows = list(rows)
         state = self.state
         pose = np.array([self._qpos[row][:3] for row in rows])
-        yaw = [math.remainder(value, math.tau) for value in pose[:, 2]]  # as MazePhysics.agent_pose
+        yaw = core.wrap_yaw(np, pose[:, 2])
         metrics = {name: value[rows] for name, value in self.rules.episode_metrics(state).items()}
         return core.episode_info(metrics, pose[:, 0], pose[:, 1], yaw, state["steps"][rows],
                                  state["episode_return"][rows], [self.configs[row].index for row in rows])

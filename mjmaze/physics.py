@@ -16,7 +16,7 @@ import mujoco as mj
 import numpy as np
 from dm_control import mujoco
 
-from mjmaze import doom, look, mjcf, render
+from mjmaze import core, doom, look, mjcf, render
 
 # Motion: Doom's player movement, tic by tic (ZDoom's P_MovePlayer and
 # P_XYMovement; measured in ViZDoom, see docs/motion.md). A held forward key
@@ -118,7 +118,7 @@ class MazePhysics(mujoco.Physics):
     def agent_pose(self) -> tuple[float, float, float]:
         """``(x, y, yaw)`` of the agent; yaw in radians in ``(-pi, pi]``, 0 facing +x."""
         x, y, yaw = self.data.qpos[:3]
-        return float(x), float(y), float(math.remainder(yaw, math.tau))
+        return float(x), float(y), float(core.wrap_yaw(np, yaw))
 
     def set_agent_pose(self, x: float, y: float, yaw: float) -> None:
         self.data.qpos[:3] = (x, y, yaw)

@@ -32,7 +32,6 @@ imports Warp or torch, only this module does.
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import mujoco
@@ -406,7 +405,7 @@ class MazeBatchEnv(batch.BatchEnv):
         """The info fields of every env (tensors ``(N,)``), each with its ``_field`` mask (``mask``, default all)."""
         task, state = self.task, self.state
         qpos = self._qpos.double()
-        yaw = qpos[:, 2] - math.tau * torch.round(qpos[:, 2] / math.tau)
+        yaw = core.wrap_yaw(torch, qpos[:, 2])
         fields = core.episode_info(task.episode_metrics(state), qpos[:, 0], qpos[:, 1], yaw, state["steps"],
                                    state["episode_return"], self._config_index)
         if mask is None:
