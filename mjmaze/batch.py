@@ -5,13 +5,14 @@ worker processes) and :class:`mjmaze.warp.MazeBatchEnv` (torch, every env in
 one MuJoCo Warp model) are both :class:`BatchEnv`: the same arguments are
 checked the same way, env ``i`` is seeded and starts in the maze list the same
 way, the spaces, the metadata and the ``info`` fields are the same. Each
-simulator then only says how it steps, draws and resets its envs.
+simulator then only says how it steps, draws and restarts its envs, and
+:func:`autoreset_step` runs a step with gymnasium's autoreset over them.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, Protocol
 
 import gymnasium as gym
 import numpy as np
@@ -65,6 +66,50 @@ def first_configs(first: int, num_envs: int, num_configs: int) -> list[int]:
     So a batch covers different mazes at once rather than every env playing configuration ``first``.
     """
     return [(int(first) + i * num_configs // num_envs) % num_configs for i in range(num_envs)]
+
+
+class Simulator(Protocol):
+    """What :func:`autoreset_step` asks of a batch simulator: masks ``(B,)`` over its envs (numpy or torch)."""
+
+    def simulate(self, actions, playing) -> tuple:
+        """The step's tics and rules: ``(reward, terminated, truncated)`` of every env, each ``(B,)``.
+        ``playing``: the envs whose action counts (None: all); the others may be left where they are."""
+
+    def keep_final(self, ended) -> Any:
+        """Keeps the last frame and infos of the envs where ``ended`` is set, before they restart."""
+
+    def restart(self, envs) -> None:
+        """Starts the next episode of the envs where ``envs`` is set."""
+
+    def draw(self) -> None:
+        """Every env's observation and infos as they now are."""
+
+
+def autoreset_step(xp, simulator: Simulator, actions, ended_before, same_step: bool) -> tuple:
+    """One step of a batch of envs with gymnasium's autoreset, the one template both vector envs follow.
+
+    ``ended_before`` ``(B,)`` marks the envs whose episode ended on the last
+    step. ``same_step``: an env that ends now keeps its last frame and infos
+    (:meth:`Simulator.keep_final`) and restarts at once; else (``next_step``)
+    an env that ended on the last step restarts now, its action ignored, with
+    reward 0 and both flags false. Returns ``(reward, terminated, truncated,
+    ended, final)``: ``ended`` is the next step's ``ended_before``, ``final``
+    what ``keep_final`` returned (None in ``next_step`` mode).
+    """
+    final = None
+    if same_step:
+        reward, terminated, truncated = simulator.simulate(actions, None)
+        restart = terminated | truncated
+        final = simulator.keep_final(restart)
+    else:
+        playing = ~ended_before
+        reward, terminated, truncated = simulator.simulate(actions, playing)
+        reward = xp.where(playing, reward, 0.0)
+        terminated, truncated = terminated & playing, truncated & playing
+        restart = ended_before
+    simulator.restart(restart)
+    simulator.draw()
+    return reward, terminated, truncated, terminated | truncated, final
 
 
 class BatchEnv(gym.vector.VectorEnv):

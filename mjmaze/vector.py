@@ -99,8 +99,8 @@ class _SharedGroup:
 
     A step runs the group's tics, rules and frames once, drawn straight into the
     envs' slots of the shared observations, results written into the shared
-    columns; no ``TimeStep`` or observation dict. Autoreset is done here, as the
-    module docstring describes.
+    columns; no ``TimeStep`` or observation dict. Autoreset is
+    :func:`mjmaze.batch.autoreset_step`'s, over this group (a :class:`mjmaze.batch.Simulator`).
     """
 
     def __init__(self, arrays: dict[str, np.ndarray], slots: list[int], first_configs: list[int], scenario: str,
@@ -113,6 +113,8 @@ class _SharedGroup:
             self._final_obs = arrays["final_obs"]
             self._final_columns = {name: arrays["final_scalars"][name] for name in scalars.dtype.names}
         self._slots = np.array(slots)
+        self._share = slice(slots[0], slots[-1] + 1)  # a group's slots are consecutive
+        self._rows = list(range(len(slots)))
         rules = suite.make_rules(scenario, task_kwargs)
         # Unseeded envs draw their keys as a dm_control task with random=None does.
         keys = batch.seed_keys([None] * len(slots))
@@ -124,58 +126,45 @@ class _SharedGroup:
         if seeds is not None:
             for row, key in enumerate(batch.seed_keys([seeds[slot] for slot in self._slots])):
                 group.reseed(row, int(key))
-        self._restart(list(range(len(group))))
-
-    def _restart(self, rows: list[int]) -> None:
-        """New episodes in ``rows``: their first frames and infos, reward 0, both flags false."""
-        group, columns = self._group, self._columns
-        group.reset(rows)
-        self._ended[rows] = False
-        slots = self._slots[rows]
-        self._observe(rows, slots)
-        columns["reward"][slots] = 0.0
-        columns["terminated"][slots] = columns["truncated"][slots] = False
-        self._write_infos(columns, rows, slots)
-
-    def _observe(self, rows: list[int], slots: np.ndarray) -> None:
-        """The frames of ``rows`` into their slots (the group's slots are consecutive)."""
-        if len(rows) == len(self._slots):
-            self._group.observe(self._obs[slots[0] : slots[-1] + 1], rows)
-        else:
-            frames = np.empty((len(rows), *self._obs.shape[1:]), dtype=np.uint8)
-            self._group.observe(frames, rows)
-            self._obs[slots] = frames
+        self._ended[:] = True
+        self.restart(self._ended)
+        self._ended[:] = False
+        self._write_outcome(0.0, False, False)
+        self.draw()
 
     def step(self) -> None:
-        columns, group = self._columns, self._group
-        ended = np.flatnonzero(self._ended).tolist()
-        playing = np.flatnonzero(~self._ended).tolist()
-        actions = self._actions[self._slots]
-        # An env about to restart (its episode ended on the last step) goes through the rules
-        # too, on its old state, which its restart then replaces; its action is ignored.
-        rewards, terminated, truncated = group.step(actions, playing)
-        if ended:
-            self._restart(ended)
-        if not playing:
-            return
-        slots = self._slots[playing]
-        self._observe(playing, slots)
-        columns["reward"][slots] = rewards[playing]
-        columns["terminated"][slots] = terminated[playing]
-        columns["truncated"][slots] = truncated[playing]
-        self._write_infos(columns, playing, slots)
-        done = [row for row in playing if terminated[row] or truncated[row]]
-        if not done:
-            return
-        if not self._same_step:
-            self._ended[done] = True
-            return
-        done_slots = self._slots[done]
-        self._final_obs[done_slots] = self._obs[done_slots]
-        self._write_infos(self._final_columns, done, done_slots)
-        group.reset(done)
-        self._observe(done, done_slots)
-        self._write_infos(columns, done, done_slots)
+        reward, terminated, truncated, self._ended, _ = batch.autoreset_step(
+            np, self, self._actions[self._share], self._ended, self._same_step)
+        self._write_outcome(reward, terminated, truncated)
+
+    def _write_outcome(self, reward, terminated, truncated) -> None:
+        columns, share = self._columns, self._share
+        columns["reward"][share] = reward
+        columns["terminated"][share] = terminated
+        columns["truncated"][share] = truncated
+
+    # -- the steps of batch.autoreset_step -------------------------------------
+
+    def simulate(self, actions: np.ndarray, playing: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return self._group.step(actions, self._rows if playing is None else np.flatnonzero(playing).tolist())
+
+    def keep_final(self, ended: np.ndarray) -> None:
+        rows = np.flatnonzero(ended).tolist()
+        if rows:
+            slots = self._slots[rows]
+            frames = np.empty((len(rows), *self._obs.shape[1:]), dtype=np.uint8)
+            self._group.observe(frames, rows)
+            self._final_obs[slots] = frames
+            self._write_infos(self._final_columns, rows, slots)
+
+    def restart(self, envs: np.ndarray) -> None:
+        rows = np.flatnonzero(envs).tolist()
+        if rows:
+            self._group.reset(rows)
+
+    def draw(self) -> None:
+        self._group.observe(self._obs[self._share], self._rows)
+        self._write_infos(self._columns, self._rows, self._slots)
 
     def _write_infos(self, columns: dict[str, np.ndarray], rows: list[int], slots: np.ndarray) -> None:
         for name, value in self._group.infos(rows).items():

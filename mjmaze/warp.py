@@ -242,7 +242,6 @@ class MazeBatchEnv(batch.BatchEnv):
         are a mask over all envs, never a list of indices, so the host queues a
         step's work without waiting for the last one to finish.
         """
-        xp, task = self.xp, self.task
         if isinstance(actions, torch.Tensor) and actions.device.type != "cpu":
             # Checking a device tensor's values would wait for the device: its shape and type only.
             if actions.shape != (self.num_envs,) or actions.dtype.is_floating_point or actions.dtype == torch.bool:
@@ -251,27 +250,21 @@ class MazeBatchEnv(batch.BatchEnv):
         else:
             actions = batch.check_actions(actions, self.num_envs, self.single_action_space.n)
         actions = torch.as_tensor(actions, device=self.device).long()
-        ended_before = self._ended
         with self._warp_stream():
-            self._advance_physics(self._actions[actions, 0], self._actions[actions, 1])
-            reward, terminated, truncated = task.step_state(xp, self.state, self._path)
-            if self.same_step:
-                restart = terminated | truncated
-                final = self._final_infos(restart)
-            else:
-                # Envs that ended on the previous step start anew; this step's action is ignored.
-                reward = torch.where(ended_before, 0.0, reward)
-                terminated = terminated & ~ended_before
-                truncated = truncated & ~ended_before
-                restart, final = ended_before, {}
-            self._start_episodes(restart)
-            self._show_state()
-        self._ended = terminated | truncated
+            reward, terminated, truncated, self._ended, final = batch.autoreset_step(
+                self.xp, self, actions, self._ended, self.same_step)
         infos = self._infos()
-        infos.update(final)
+        infos.update(final or {})
         return self._obs.clone(), reward.float(), terminated, truncated, infos
 
-    def _final_infos(self, ended: torch.Tensor) -> dict:
+    # -- the steps of batch.autoreset_step (every env, masks: no host reads) ---
+
+    def simulate(self, actions: torch.Tensor, playing: torch.Tensor | None) -> tuple:
+        """Every env's tics and rules (an env not ``playing`` restarts now: its outcome is masked out)."""
+        self._advance_physics(self._actions[actions, 0], self._actions[actions, 1])
+        return self.task.step_state(self.xp, self.state, self._path)
+
+    def keep_final(self, ended: torch.Tensor) -> dict:
         """``final_info`` (and ``final_obs``) of the envs that just ended, before they are reset.
 
         Built on every step (the mask says which envs it is for): finding out
@@ -283,6 +276,12 @@ class MazeBatchEnv(batch.BatchEnv):
             final["final_obs"] = self._obs.clone()
             final["_final_obs"] = ended
         return final
+
+    def restart(self, envs: torch.Tensor) -> None:
+        self._start_episodes(envs)
+
+    def draw(self) -> None:
+        self._show_state()
 
     def close_extras(self, **kwargs: Any) -> None:
         self.state = None
