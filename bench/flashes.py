@@ -27,9 +27,10 @@ SIDES = {"on": {"flashes": True}, "off": {"flashes": False}, "default": {}}
 
 
 def steps_per_second(scenario: str, side: str, steps: int) -> float:
-    rules = mjmaze.suite.make_rules(scenario, {**SETTINGS[scenario], **SIDES[side]})
-    group = EnvGroup(rules, base.make_physics(rules), [0])
-    frame = np.zeros((1, rules.height, rules.width, 3), np.uint8)
+    kwargs = {**SETTINGS[scenario], **SIDES[side]}
+    rules, view = mjmaze.suite.make_rules(scenario, kwargs), mjmaze.suite.make_view(scenario, kwargs)
+    group = EnvGroup(rules, view, base.make_physics(rules, view), [0])
+    frame = np.zeros((1, *view.frame_shape), np.uint8)
     group.reset([0])
     actions = np.random.default_rng(0).integers(len(rules.actions), size=(steps, 1))
     start = time.perf_counter()

@@ -19,7 +19,7 @@ import time
 import mujoco
 
 import mjmaze
-from mjmaze import configs, core, mjcf, render, walls
+from mjmaze import configs, core, look, mjcf, render, walls
 from mjmaze.tasks import labyrinth
 
 
@@ -48,7 +48,7 @@ def main() -> None:
 
     env = mjmaze.load("labyrinth", task_kwargs={"size": size, "num_configs": n})
     env.reset()  # GL context and first render context exist from here on
-    config_set = env.task.configs
+    config_set = env.task.rules.configs
     [config_set[i] for i in range(n)]  # generate outside the timings
 
     before = rss_mb()
@@ -58,7 +58,7 @@ def main() -> None:
     pool_ms = 1e3 * (time.perf_counter() - start) / n
     pool_mb = rss_mb() - before
 
-    xml = mjcf.build_xml(size, labyrinth.CELL_SIZE, labyrinth.Labyrinth.objects, width=core.DEFAULT_WIDTH)
+    xml = mjcf.build_xml(size, labyrinth.CELL_SIZE, labyrinth.Labyrinth.objects, width=look.DEFAULT_WIDTH)
     before = rss_mb()
     start = time.perf_counter()
     cache = []

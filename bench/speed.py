@@ -67,9 +67,10 @@ def bench_raw(size: int, steps: int, style: str) -> float:
 
 
 def bench_lean(size: int, steps: int, style: str) -> float:
-    rules = mjmaze.suite.make_rules("labyrinth", {"size": size, "visual_style": style})
-    group = EnvGroup(rules, base.make_physics(rules), [0])
-    frame = np.empty((1, rules.height, rules.width, 3), np.uint8)
+    kwargs = {"size": size, "visual_style": style}
+    rules, view = mjmaze.suite.make_rules("labyrinth", kwargs), mjmaze.suite.make_view("labyrinth", kwargs)
+    group = EnvGroup(rules, view, base.make_physics(rules, view), [0])
+    frame = np.empty((1, *view.frame_shape), np.uint8)
     actions = np.random.default_rng(0).integers(5, size=(steps, 1))
     group.reset([0])
     start = time.perf_counter()

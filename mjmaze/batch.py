@@ -19,7 +19,7 @@ import numpy as np
 from gymnasium.vector import AutoresetMode
 from gymnasium.vector.utils import batch_space
 
-from mjmaze import core, rules
+from mjmaze import core, look, rules
 
 AUTORESET_MODES = {"next_step": AutoresetMode.NEXT_STEP, "same_step": AutoresetMode.SAME_STEP}
 
@@ -126,10 +126,12 @@ class BatchEnv(gym.vector.VectorEnv):
         num_envs: int,
         scenario: str,
         task: core.MazeRules,
+        view: look.View,
         autoreset_mode: str | AutoresetMode,
         render_modes: Sequence[str],
     ) -> None:
-        """Checks ``num_envs`` and ``autoreset_mode`` and sets the spaces and metadata of ``task``'s envs."""
+        """Checks ``num_envs`` and ``autoreset_mode`` and sets the spaces and metadata of envs of ``task``'s
+        rules whose frames look as ``view`` says."""
         if not isinstance(num_envs, (int, np.integer)) or isinstance(num_envs, bool) or num_envs < 1:
             raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
         mode = parse_autoreset_mode(autoreset_mode)
@@ -137,7 +139,7 @@ class BatchEnv(gym.vector.VectorEnv):
         self.scenario = scenario
         self.autoreset_mode = mode
         self.metadata = {"autoreset_mode": mode, "render_modes": list(render_modes), "render_fps": core.STEPS_PER_SECOND}
-        self.single_observation_space = gym.spaces.Box(0, 255, (task.height, task.width, 3), np.uint8)
+        self.single_observation_space = gym.spaces.Box(0, 255, view.frame_shape, np.uint8)
         self.single_action_space = gym.spaces.Discrete(len(task.actions))
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)

@@ -7,7 +7,8 @@ episode (:meth:`MazeRules.rules`). Both are array functions over a batch of
 envs (:mod:`mjmaze.rules`): a CPU env calls them with a batch of one on numpy
 (its vector env, once per step for each process's envs), the MuJoCo Warp
 backend (:mod:`mjmaze.warp`) with thousands on torch. Nothing here simulates
-or draws: the dm_control task (:class:`mjmaze.tasks.base.MazeTask`) and the
+or draws, nor knows how frames look (their size and style are a
+:class:`mjmaze.look.View`): the dm_control task (:class:`mjmaze.tasks.base.MazeTask`) and the
 Warp backend each move their arena to match the state the rules keep
 (:class:`EpisodeState`).
 """
@@ -19,19 +20,20 @@ import functools
 import math
 import os
 from collections.abc import Sequence
-from typing import Any, TypedDict
+from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
 
-from mjmaze import configs, doom, mjcf, palette, rules
+from mjmaze import configs, doom, palette, rules
 from mjmaze import layouts as layout_files
+
+if TYPE_CHECKING:
+    from mjmaze import mjcf
 
 # Timing: one physics step is one Doom tic (mjmaze.doom); the agent acts every 4 tics.
 STEPS_PER_SECOND = doom.TICS_PER_SECOND / doom.TICS_PER_STEP  # real time: 8.75 observations a second
 EPISODE_STEPS = 525  # 2100 tics
 AGENT_RADIUS = 0.125
-
-DEFAULT_WIDTH, DEFAULT_HEIGHT = 112, 64
 
 # (forward, turn) per action; turn +1 is to the left (counter-clockwise).
 ACTION_SETS = {
@@ -90,30 +92,11 @@ class MazeRules(abc.ABC):
         config_sampling: str = "cycle",
         first_config: int = 0,
         action_set: str = "default",
-        width: int = DEFAULT_WIDTH,
-        height: int = DEFAULT_HEIGHT,
         layouts: str | os.PathLike | None = None,
-        visual_style: str = "textured",
-        head_bob: bool = True,
-        flashes: bool = True,
     ):
-        check_choice("visual_style", visual_style, mjcf.VISUAL_STYLES)
-        #: "textured" (default: the depth cues of the paper's frames) or "flat" (cheaper); see mjmaze.mjcf.
-        self.visual_style = visual_style
-        if not isinstance(head_bob, (bool, np.bool_)):
-            raise ValueError(f"head_bob must be True or False, got {head_bob!r}")
-        #: Doom's head-bob while walking: the eye swings, the pistol sways (:func:`mjmaze.look.view_bob`).
-        self.head_bob = bool(head_bob)
-        if not isinstance(flashes, (bool, np.bool_)):
-            raise ValueError(f"flashes must be True or False, got {flashes!r}")
-        #: Doom's full-screen flashes: red when hurt, gold on a pickup (:func:`mjmaze.rules.flash`).
-        self.flashes = bool(flashes)
         check_choice("split", split, configs.SPLITS)
         check_choice("config_sampling", config_sampling, configs.CONFIG_SAMPLING)
         check_choice("action_set", action_set, tuple(ACTION_SETS))
-        for name, value in (("width", width), ("height", height)):
-            if not isinstance(value, (int, np.integer)) or not 16 <= value <= 1024:
-                raise ValueError(f"{name} must be an integer in 16..1024, got {value!r}")
         self.layout = layout
         if layouts is None:
             self.configs = configs.ConfigSet(self.scenario, difficulty, split, layout, num_configs)
@@ -124,7 +107,6 @@ class MazeRules(abc.ABC):
         self.action_set = action_set
         #: ``(forward, turn)`` of each action.
         self.actions = ACTION_SETS[action_set]
-        self.width, self.height = int(width), int(height)
 
     # -- which configuration, which draws ---------------------------------
 
@@ -223,12 +205,7 @@ class MazeRules(abc.ABC):
         state["episode_return"] = state["episode_return"] + reward
         return reward, terminated, ~terminated & (state["steps"] >= EPISODE_STEPS)
 
-    # -- what a frame shows, what an env reports -----------------------------
-
-    @property
-    def draws_pistol(self) -> bool:
-        """Whether frames show the pistol: where the released runs did, in the paper's look ("textured")."""
-        return self.pistol and self.visual_style == "textured"
+    # -- what an env reports ----------------------------------------------------
 
     @property
     def action_names(self) -> tuple[str, ...]:

@@ -26,15 +26,16 @@ class EnvGroup:
 
     Args:
       rules: the scenario's core (:class:`mjmaze.core.MazeRules`), shared by every row.
+      view: how the frames look (:class:`mjmaze.look.View`).
       physics: each env's physics, built from the scenario's arena with its projection
         (:func:`mjmaze.tasks.base.make_physics`).
       seed_keys: each env's key for its episodes' draws (:func:`mjmaze.rules.seed_key`).
       first_configs: where each env starts cycling through the configurations (default: the rules').
     """
 
-    def __init__(self, rules: core.MazeRules, physics: Sequence[MazePhysics], seed_keys: Sequence[int],
-                 first_configs: Sequence[int] | None = None):
-        self.rules = rules
+    def __init__(self, rules: core.MazeRules, view: look.View, physics: Sequence[MazePhysics],
+                 seed_keys: Sequence[int], first_configs: Sequence[int] | None = None):
+        self.rules, self.view = rules, view
         self.physics = list(physics)
         count = len(self.physics)
         self.seed_keys = np.array(seed_keys, dtype=np.int64)
@@ -49,7 +50,7 @@ class EnvGroup:
         self._models, self._data = models, [p.data.ptr for p in self.physics]
         self._qpos = [data.qpos for data in self._data]
         self._walls = [walls.WallLayout(model, rules.layout.grid_size, rules.layout.cell_size) for model in models]
-        self.pipeline = look.FramePipeline(np, "cpu", rules, models[0])
+        self.pipeline = look.FramePipeline(np, "cpu", view, rules, models[0])
         self.renderers: list[render.EgoRenderer] = []
         self.open()
         self._eyes = [model.cam(CAMERA).pos for model in models]  # views into the models: head-bob moves them
@@ -213,7 +214,7 @@ class EnvGroup:
     def _frame_buffers(self, count: int) -> tuple[np.ndarray, np.ndarray | None]:
         """GL's colour and depth buffers for ``count`` frames (bottom-up rows), kept between calls."""
         if self._buffers is None or len(self._buffers[0]) != count:
-            height, width = self.rules.height, self.rules.width
+            height, width = self.view.height, self.view.width
             rgb = np.empty((count, height, width, 3), dtype=np.uint8)
             depth = np.empty((count, height, width), dtype=np.float32) if self.pipeline.needs_depth else None
             self._buffers = rgb, depth
@@ -234,8 +235,8 @@ class EnvGroup:
     def open(self) -> None:
         """Makes the renderers (each uploads its model's meshes as they are), unless they are open."""
         if not self.renderers:
-            rules = self.rules
-            self.renderers = [render.EgoRenderer(model, CAMERA, rules.width, rules.height,
+            view = self.view
+            self.renderers = [render.EgoRenderer(model, CAMERA, view.width, view.height,
                                                  depth=self.pipeline.needs_depth) for model in self._models]
 
     def close(self) -> None:

@@ -9,6 +9,7 @@ measured in ViZDoom (docs/look.md).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 
@@ -16,6 +17,52 @@ import mujoco
 import numpy as np
 
 from mjmaze import compiled_light, doom, mjcf, palette, rules, sprites, walls
+
+DEFAULT_WIDTH, DEFAULT_HEIGHT = 112, 64
+
+
+@dataclasses.dataclass(frozen=True)
+class View:
+    """How an env's frames look: their size and what Doom draws beyond the scene (the rules know none of it).
+
+    A scenario's task arguments ``width``, ``height``, ``visual_style``,
+    ``head_bob`` and ``flashes`` make one (:func:`mjmaze.suite.make_view`).
+    """
+
+    #: The frames' size in pixels (16..1024 each).
+    width: int = DEFAULT_WIDTH
+    height: int = DEFAULT_HEIGHT
+    #: "textured" (default: the depth cues of the paper's frames) or "flat" (cheaper); see mjmaze.mjcf.
+    visual_style: str = "textured"
+    #: Doom's head-bob while walking: the eye swings, the pistol sways (:func:`view_bob`).
+    head_bob: bool = True
+    #: Doom's full-screen flashes: red when hurt, gold on a pickup (:func:`mjmaze.rules.flash`).
+    flashes: bool = True
+
+    def __post_init__(self):
+        for name in ("width", "height"):
+            value = getattr(self, name)
+            if not isinstance(value, (int, np.integer)) or isinstance(value, bool) or not 16 <= value <= 1024:
+                raise ValueError(f"{name} must be an integer in 16..1024, got {value!r}")
+            object.__setattr__(self, name, int(value))
+        if self.visual_style not in mjcf.VISUAL_STYLES:
+            raise ValueError(f"visual_style must be one of {mjcf.VISUAL_STYLES}, got {self.visual_style!r}")
+        for name in ("head_bob", "flashes"):
+            value = getattr(self, name)
+            if not isinstance(value, (bool, np.bool_)):
+                raise ValueError(f"{name} must be True or False, got {value!r}")
+            object.__setattr__(self, name, bool(value))
+
+    @property
+    def textured(self) -> bool:
+        """Whether frames have the paper's look (Doom's light, sprites, textures)."""
+        return self.visual_style == "textured"
+
+    @property
+    def frame_shape(self) -> tuple[int, int, int]:
+        """``(height, width, 3)``: one observation's shape."""
+        return self.height, self.width, 3
+
 
 # Head-bob: Doom's P_CalcHeight and P_BobWeapon. Walking swings the eye by half
 # the "bob", min(v^2 / 4, 16) map units with v the speed after the tic's thrust
@@ -28,7 +75,7 @@ PISTOL_BOB_TICS = 64
 PISTOL_BOB_PIXELS = (0.751 / 320, 0.903 / 180)  # (x, y) shift per unit of bob, as fractions of the frame
 
 # The pistol ViZDoom draws over the bottom of the view where a map gives the
-# player one (none of the released maps does: mjmaze.tasks.base.MazeTask.pistol):
+# player one (none of the released maps does: mjmaze.core.MazeRules.pistol):
 # Freedoom's pistol and hand, ~3% of a 112x64 frame. Drawn as its two parts'
 # boxes, (left, right, top, bottom) as fractions of the frame, in their mean
 # colours as ViZDoom draws them.
@@ -339,14 +386,17 @@ class FramePipeline:
     every world (:mod:`mjmaze.warp`). Made once per model and device.
     """
 
-    def __init__(self, xp, device, task, model: mujoco.MjModel):
+    def __init__(self, xp, device, view: View, arena, model: mujoco.MjModel):
+        """``arena``: what the scenario's arena holds (its ``objects``, ``layout``, whether it has a
+        ``pistol``: a :class:`mjmaze.core.MazeRules`)."""
         self._xp, self._device = xp, device
-        self._width, self._height = task.width, task.height
-        textured = task.visual_style == "textured"
-        self.sprites = SpriteView(xp, device, model, task.objects, task.width) if textured else None
-        self.light = (DoomLight(xp, device, task.width, task.height, task.layout.grid_size, task.layout.cell_size)
+        self._width, self._height = view.width, view.height
+        textured = view.textured
+        self.sprites = SpriteView(xp, device, model, arena.objects, view.width) if textured else None
+        self.light = (DoomLight(xp, device, view.width, view.height, arena.layout.grid_size, arena.layout.cell_size)
                       if textured else None)
-        self._head_bob, self._pistol, self._flashes = task.head_bob, task.draws_pistol, task.flashes
+        # The pistol is drawn where the released runs drew it: in the paper's look.
+        self._head_bob, self._pistol, self._flashes = view.head_bob, arena.pistol and textured, view.flashes
         self._tints: dict[tuple[int, int], tuple] = {}  # (damage, bonus) -> the flash's (rgb, alpha), on numpy
         if self.sprites is not None and len(self.sprites):
             self._sprite_objects = xp.asarray(self.sprites.object_index, device=device)

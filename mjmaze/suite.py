@@ -8,6 +8,7 @@ gymnasium id; a scenario defined elsewhere joins with :func:`register`.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import importlib
 import inspect
 import pkgutil
@@ -15,8 +16,11 @@ import pkgutil
 import gymnasium
 from dm_control.rl import control
 
-from mjmaze import core, registry, tasks
+from mjmaze import core, look, registry, tasks
 from mjmaze.tasks import base
+
+#: The task arguments that say how frames look (:class:`mjmaze.look.View`), every scenario's.
+VIEW_ARGUMENTS = tuple(field.name for field in dataclasses.fields(look.View))
 
 
 def register(scenario: registry.Scenario) -> registry.Scenario:
@@ -61,8 +65,10 @@ def _parameters(function, skip=("self", "kwargs", "difficulty", "layout")) -> tu
 
 
 def task_kwarg_names(name: str) -> tuple[str, ...]:
-    """The task arguments scenario ``name`` accepts."""
-    return _parameters(registry.get(name).task.__init__) + _parameters(core.MazeRules.__init__) + ("random",)
+    """The task arguments scenario ``name`` accepts: its rules' (its own, then every scenario's), the
+    view's (:data:`VIEW_ARGUMENTS`) and ``random``."""
+    return (_parameters(registry.get(name).task.__init__) + _parameters(core.MazeRules.__init__) + VIEW_ARGUMENTS
+            + ("random",))
 
 
 class UnknownArgumentError(TypeError, ValueError):
@@ -71,30 +77,37 @@ class UnknownArgumentError(TypeError, ValueError):
     and a ``ValueError``, as mjmaze's other argument errors."""
 
 
-def _checked(name: str, task_kwargs: dict | None) -> dict:
+def _split(name: str, task_kwargs: dict | None) -> tuple[dict, dict, dict]:
+    """Scenario ``name``'s task arguments, checked, as ``(rules', view's, the task's own)``."""
     task_kwargs = dict(task_kwargs or {})
     valid = task_kwarg_names(name)
     unknown = sorted(set(task_kwargs) - set(valid))
     if unknown:
         raise UnknownArgumentError(f"{name!r} got an unexpected keyword argument {', '.join(map(repr, unknown))}; "
                                    f"valid: {valid}")
-    return task_kwargs
+    view = {key: task_kwargs.pop(key) for key in VIEW_ARGUMENTS if key in task_kwargs}
+    own = {key: task_kwargs.pop(key) for key in ("random",) if key in task_kwargs}
+    return task_kwargs, view, own
 
 
 def make_task(name: str, task_kwargs: dict | None = None) -> base.MazeTask:
     """The dm_control task of scenario ``name`` (no physics, no rendering yet); checks its arguments."""
-    return base.task_class(registry.get(name).task)(**_checked(name, task_kwargs))
+    return base.MazeTask(make_rules(name, task_kwargs), make_view(name, task_kwargs), **_split(name, task_kwargs)[2])
 
 
 def make_rules(name: str, task_kwargs: dict | None = None) -> core.MazeRules:
     """Scenario ``name``'s core alone: its settings, mazes and batched rules, for a batch simulator.
 
-    Takes the task arguments of :func:`make_task` (``random``, the seed of a
+    Takes the task arguments of :func:`make_task`, all checked; it reads the
+    rules' (the view's are :func:`make_view`'s; ``random``, the seed of a
     dm_control task's episodes, has no use here: a batch env seeds its envs at ``reset``).
     """
-    task_kwargs = _checked(name, task_kwargs)
-    task_kwargs.pop("random", None)
-    return registry.get(name).task(**task_kwargs)
+    return registry.get(name).task(**_split(name, task_kwargs)[0])
+
+
+def make_view(name: str, task_kwargs: dict | None = None) -> look.View:
+    """How scenario ``name``'s frames look, from its task arguments (all checked; see :func:`make_rules`)."""
+    return look.View(**_split(name, task_kwargs)[1])
 
 
 def load(name: str, task_kwargs: dict | None = None, environment_kwargs: dict | None = None) -> control.Environment:

@@ -115,10 +115,10 @@ class _SharedGroup:
         self._slots = np.array(slots)
         self._share = slice(slots[0], slots[-1] + 1)  # a group's slots are consecutive
         self._rows = list(range(len(slots)))
-        rules = suite.make_rules(scenario, task_kwargs)
+        rules, view = suite.make_rules(scenario, task_kwargs), suite.make_view(scenario, task_kwargs)
         # Unseeded envs draw their keys as a dm_control task with random=None does.
         keys = batch.seed_keys([None] * len(slots))
-        self._group = EnvGroup(rules, base.make_physics(rules, len(slots)), keys, first_configs)
+        self._group = EnvGroup(rules, view, base.make_physics(rules, view, len(slots)), keys, first_configs)
         self._ended = np.zeros(len(slots), dtype=bool)  # next-step mode: the env resets on its next step
 
     def reset(self, seeds: list[int] | None) -> None:
@@ -327,7 +327,8 @@ class MazeVectorEnv(batch.BatchEnv):
             raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
         # Checks the arguments here, in this process, and tells shapes and info fields.
         probe = suite.make_rules(scenario, task_kwargs)
-        self._setup(num_envs, scenario, probe, autoreset_mode, render_modes=["rgb_array"])
+        self._setup(num_envs, scenario, probe, suite.make_view(scenario, task_kwargs), autoreset_mode,
+                    render_modes=["rgb_array"])
         self.render_mode = render_mode
         usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
         if num_workers is None:

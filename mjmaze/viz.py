@@ -51,15 +51,15 @@ class TopDown:
         self.task: base.MazeTask = env.task
         self.physics: base.MazePhysics = env.physics
         self.size = int(size)
-        layout = self.task.layout
+        layout = self.task.rules.layout
         self.extent = mjcf.overhead_extent(layout.grid_size, layout.cell_size)
         self._renderer = render.EgoRenderer(
             self.physics.model.ptr, mjcf.OVERHEAD_CAMERA, self.size, self.size, map_view=True
         )
         self._wall_mesh = self.physics.model.ptr.mesh(walls.WALL_MESH).id
         model = self.physics.model.ptr
-        self._sprite_ids = mjcf.sprite_geoms(model, self.task.objects)
-        by_name = {obj.name: obj for obj in self.task.objects}
+        self._sprite_ids = mjcf.sprite_geoms(model, self.task.rules.objects)
+        by_name = {obj.name: obj for obj in self.task.rules.objects}
         self._sprite_rgba = np.array([by_name[model.geom(int(g)).name].rgba for g in self._sprite_ids]).reshape(-1, 4)
 
     def to_pixels(self, xy) -> np.ndarray:
@@ -126,8 +126,8 @@ class TopDown:
         kind of object shown now, in its colour on the map (objects named ``item_3`` count as "item")."""
         entries = [("spawn", SPAWN_COLOUR), ("path", PATH_COLOUR), ("agent", AGENT_COLOUR)]
         model = self.physics.model.ptr
-        ids = self.physics.object_ids([obj.name for obj in self.task.objects])[1]
-        for obj, geom in zip(self.task.objects, ids):
+        ids = self.physics.object_ids([obj.name for obj in self.task.rules.objects])[1]
+        for obj, geom in zip(self.task.rules.objects, ids):
             if model.geom_group[geom] == render.HIDDEN_GROUP:
                 continue
             label = re.sub(r"_?\d+$", "", obj.name).replace("_", " ")

@@ -51,7 +51,7 @@ _AWAY_Z = -50.0
 _CONTACTS_PER_WORLD = 32
 
 
-def build_model(task: core.MazeRules) -> tuple[mujoco.MjModel, np.ndarray, np.ndarray]:
+def build_model(task: core.MazeRules, view: look.View) -> tuple[mujoco.MjModel, np.ndarray, np.ndarray]:
     """The task's arena as one MuJoCo model for all worlds, with a wall mesh per layout (:func:`mjmaze.mjcf.build_xml`).
 
     Returns ``(model, mesh_of_config (C,), box_z_of_config (C, boxes))``: which
@@ -67,11 +67,11 @@ def build_model(task: core.MazeRules) -> tuple[mujoco.MjModel, np.ndarray, np.nd
     for config, mesh in zip(all_configs, mesh_of_config):
         first_of_layout.setdefault(int(mesh), config)
     quads = [walls.wall_mesh_quads(c.h_walls, c.v_walls, layout.cell_size) for c in first_of_layout.values()]
-    xml = mjcf.build_xml(layout.grid_size, layout.cell_size, task.objects, task.visual_style, task.room,
-                         wall_layout_quads=quads, width=task.width)
+    xml = mjcf.build_xml(layout.grid_size, layout.cell_size, task.objects, view.visual_style, task.room,
+                         wall_layout_quads=quads, width=view.width)
     model = mujoco.MjModel.from_xml_string(xml)
-    mjcf.paint_textures(model, task.room, task.objects, task.width, layout.cell_size)
-    mjcf.set_ego_projection(model, task.width, task.height)
+    mjcf.paint_textures(model, task.room, task.objects, view.width, layout.cell_size)
+    mjcf.set_ego_projection(model, view.width, view.height)
     for mesh, config in first_of_layout.items():
         mesh_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MESH, f"{walls.WALL_MESH}_{mesh}")
         walls.write_wall_mesh(model, mesh_id, config.h_walls, config.v_walls, layout.cell_size)
@@ -139,7 +139,8 @@ class MazeBatchEnv(batch.BatchEnv):
         wp.init()
         first = int(task_kwargs.pop("first_config", 0))
         self.task = task = suite.make_rules(scenario, task_kwargs)
-        self._setup(num_envs, scenario, task, autoreset_mode, render_modes=[])
+        self.view = view = suite.make_view(scenario, task_kwargs)
+        self._setup(num_envs, scenario, task, view, autoreset_mode, render_modes=[])
         n = self.num_envs
         self.device = torch.device(device)
         if restart_by_index is None:
@@ -147,9 +148,9 @@ class MazeBatchEnv(batch.BatchEnv):
         self.restart_by_index = bool(restart_by_index)
         self._wp_device = wp.get_device(str(device))
         self.xp = rules.namespace(torch.zeros(1))
-        height, width = task.height, task.width
+        height, width = view.height, view.width
 
-        mjm, mesh_of_config, box_z = build_model(task)
+        mjm, mesh_of_config, box_z = build_model(task, view)
         self._host_model = mjm
         dev = self.device
         table = task.config_arrays([task.configs[i] for i in range(len(task.configs))])
@@ -168,7 +169,7 @@ class MazeBatchEnv(batch.BatchEnv):
         self._object_ids = torch.tensor([geom(obj.name) for obj in task.objects], dtype=torch.long, device=dev)
         self._object_z = torch.tensor([obj.z for obj in task.objects], dtype=torch.float32, device=dev)
         # What Doom draws beyond the scene, for every world at once: the CPU envs' pipeline.
-        self._pipeline = look.FramePipeline(self.xp, dev, task, mjm)
+        self._pipeline = look.FramePipeline(self.xp, dev, view, task, mjm)
         self._sprites = self._pipeline.sprites
         self._sprite_ids = torch.as_tensor(self._sprites.geom_ids if self._sprites else [], dtype=torch.long, device=dev)
         self._sprite_objects = torch.as_tensor(self._sprites.object_index if self._sprites else [], dtype=torch.long,
@@ -181,9 +182,9 @@ class MazeBatchEnv(batch.BatchEnv):
         self._timestep = float(mjm.opt.timestep)
         self._actions = torch.tensor(task.actions, dtype=torch.float64, device=dev)  # (A, 2): forward, turn
 
-        textured = task.visual_style == "textured"
+        textured = view.textured
         with wp.ScopedDevice(self._wp_device):
-            batched = ({"geom_pos": n, "geom_rgba": n, "geom_dataid": n} | ({"cam_pos": n} if task.head_bob else {})
+            batched = ({"geom_pos": n, "geom_rgba": n, "geom_dataid": n} | ({"cam_pos": n} if view.head_bob else {})
                        | ({"geom_quat": n, "geom_matid": n} if len(self._sprite_ids) else {}))
             self._model = mjw.put_model(mjm, batch_sizes=batched)
             self._data = mjw.put_data(mjm, mujoco.MjData(mjm), nworld=n, nconmax=_CONTACTS_PER_WORLD, njmax=_CONTACTS_PER_WORLD)
@@ -374,10 +375,9 @@ class MazeBatchEnv(batch.BatchEnv):
         if not self._rendering:
             return
         m, d, rc = self._model, self._data, self._render
-        task = self.task
         sprite_xy = self._geom_pos[:, self._sprite_ids, 0:2] if len(self._sprite_ids) else None
         scene = self._pipeline.scene(self.state, self._qpos[:, 0:2], self._qpos[:, 2], self._bob, sprite_xy)
-        if task.head_bob:
+        if self.view.head_bob:
             self._cam_pos[:, self._camera, 2] = (mjcf.EYE_HEIGHT + scene["eye_dz"]).float()
         if len(self._sprite_ids):  # Doom's sprites: facing the camera, at their animation frame and depth
             self._geom_matid[:, self._sprite_ids] = scene["sprite_material"].int()
@@ -387,7 +387,7 @@ class MazeBatchEnv(batch.BatchEnv):
         mjw.refit_bvh(m, d, rc)
         mjw.render(m, d, rc)
         # Packed 0xAABBGGRR per pixel: bytes R, G, B, A in memory.
-        packed = self._rgb_packed.view(torch.uint8).view(self.num_envs, task.height, task.width, 4)
+        packed = self._rgb_packed.view(torch.uint8).view(self.num_envs, self.view.height, self.view.width, 4)
         inverse_depth = 1 / self._depth if self._depth is not None else None
         # Doom's light and what Doom draws over the scene, as on the CPU (mjmaze.look).
         self._obs.copy_(self._pipeline.finish(packed[..., [2, 1, 0]], inverse_depth, self._cam_xpos[:, self._camera],
@@ -397,7 +397,7 @@ class MazeBatchEnv(batch.BatchEnv):
         """``(N, H, W)`` geom id drawn at each pixel of the last frames, -1 for none (needs ``render_segmentation``)."""
         if not self._segmentation:
             raise RuntimeError("create the env with render_segmentation=True to read segmentation")
-        seg = wp.to_torch(self._render.seg_data).view(self.num_envs, self.task.height, self.task.width, 2)
+        seg = wp.to_torch(self._render.seg_data).view(self.num_envs, self.view.height, self.view.width, 2)
         return torch.where(seg[..., 1] == int(mujoco.mjtObj.mjOBJ_GEOM), seg[..., 0], -1)
 
     def _infos(self, mask: torch.Tensor | None = None) -> dict:

@@ -92,9 +92,9 @@ def test_a_fifth_scenario_in_the_vector_env():
 
 def test_a_fifth_scenario_gets_its_own_configurations_and_flags():
     task = suite.make_task("beacon", {"size": 4})
-    assert task.configs[0].size == 4
-    first = configs.generate_config("beacon", 4, "train", 0, task.layout)
-    assert first.config_key() != configs.generate_config("labyrinth", 4, "train", 0, task.layout).config_key()
+    assert task.rules.configs[0].size == 4
+    first = configs.generate_config("beacon", 4, "train", 0, task.rules.layout)
+    assert first.config_key() != configs.generate_config("labyrinth", 4, "train", 0, task.rules.layout).config_key()
     import argparse
 
     parser = argparse.ArgumentParser()
@@ -228,7 +228,7 @@ def test_gymnasium_spaces_info_and_render(name):
     assert env.action_space == gymnasium.spaces.Discrete(5)
     assert env.observation_space == gymnasium.spaces.Box(0, 255, (64, 112, 3), np.uint8)
     obs, info = env.reset(seed=1)
-    expected = set(env.unwrapped.task.info_fields())
+    expected = set(env.unwrapped.task.rules.info_fields())
     assert set(info) == expected and registry.get(name).metric in info
     obs, reward, terminated, truncated, info = env.step(2)
     assert set(info) == expected and isinstance(reward, float)

@@ -117,14 +117,14 @@ def test_wall_textures_start_again_at_each_grid_line_as_the_released_blocks_do()
 def flat_views(task, centre, extent=1.0, pixels=128):
     """GL's frames (before Doom's light) of ``task``'s floor from above and ceiling from below: orthographic
     views of an ``extent``-metre square around ``centre``, image right along +x, image up along +y."""
-    root = ET.fromstring(mjcf.build_xml(task.layout.grid_size, task.layout.cell_size, room=task.room, width=task.width))
+    root = ET.fromstring(mjcf.build_xml(task.rules.layout.grid_size, task.rules.layout.cell_size, room=task.rules.room, width=task.view.width))
     x, y = centre
     for name, z, axes in (("down", 0.5, "1 0 0 0 1 0"), ("up", 0.5, "1 0 0 0 -1 0")):
         ET.SubElement(root.find("worldbody"), "camera", name=name, pos=f"{x} {y} {z}", xyaxes=axes,
                       projection="orthographic", fovy=str(extent))
     root.find("visual/global").attrib.update(offwidth=str(pixels), offheight=str(pixels))
     model = mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
-    mjcf.paint_textures(model, task.room, (), task.width, task.layout.cell_size)
+    mjcf.paint_textures(model, task.rules.room, (), task.view.width, task.rules.layout.cell_size)
     # Whiter, so GL draws the texels themselves rather than a few dim grey levels
     # (GL's colour: the material's times its emission plus the ambient light).
     for name in ("floor", "ceiling"):
@@ -149,9 +149,9 @@ def test_floor_and_ceiling_show_their_flats_laid_as_in_the_released_maps(scenari
     floor, ceiling = flat_views(task, centre, extent, pixels)
     env.close()
     offsets = (np.arange(pixels) + 0.5 - pixels / 2) * extent / pixels
-    map_x = (centre[0] + offsets[None, :] - task.layout.cell_size / 2) / doom.MAP_UNIT  # map units
-    map_y = (centre[1] - offsets[:, None] - task.layout.cell_size / 2) / doom.MAP_UNIT
-    for view, texture in ((floor, task.room.floor_texture), (ceiling, task.room.ceiling_texture)):
+    map_x = (centre[0] + offsets[None, :] - task.rules.layout.cell_size / 2) / doom.MAP_UNIT  # map units
+    map_y = (centre[1] - offsets[:, None] - task.rules.layout.cell_size / 2) / doom.MAP_UNIT
+    for view, texture in ((floor, task.rules.room.floor_texture), (ceiling, task.rules.room.ceiling_texture)):
         # mjmaze draws a flat in texels of 2 x 2 map units (mjcf.surface_texels).
         grey = sprites.surface(texture).astype(np.float64).mean(axis=2).reshape(32, 2, 32, 2).mean(axis=(1, 3))
 
@@ -194,13 +194,13 @@ def test_a_wrong_item_passed_mid_step_ends_the_episode():
 def test_a_two_colour_item_passed_mid_step_is_picked_up():
     env = load("two_colour", complexity=0)
     task = env.task
-    task.item_xy[:] = (4.5, 4.5)  # every item out of the way but one
-    task.item_xy[0] = (-2.0, -3.0)
-    env.physics.place_objects(env.physics.object_ids([item.name for item in two_colour.ITEMS])[0], task.item_xy)
-    beside(env, task.item_xy[0])
+    task.state["object_xy"][0, 1:][:] = (4.5, 4.5)  # every item out of the way but one
+    task.state["object_xy"][0, 1:][0] = (-2.0, -3.0)
+    env.physics.place_objects(env.physics.object_ids([item.name for item in two_colour.ITEMS])[0], task.state["object_xy"][0, 1:])
+    beside(env, task.state["object_xy"][0, 1:][0])
     env.step(FORWARD)
-    assert not task.item_active[0]
-    assert task.item_active[1:20].all()
+    assert not task.state["object_shown"][0, 1:][0]
+    assert task.state["object_shown"][0, 1:][1:20].all()
 
 
 # -- contacts -------------------------------------------------------------------
@@ -220,7 +220,7 @@ def test_the_agent_stops_at_its_radius_from_a_wall_at_every_tic(heading):
     env = load("two_colour", complexity=0, item_cap=0)
     face = 5.0  # the outer wall's face is the maze's edge
     place(env, face - 1.0, -2.0, math.radians(heading))
-    env.task.health = 10**6  # no death in 50 steps
+    env.task.state["health"][0] = 10**6  # no death in 50 steps
     path = push(env, FORWARD, 50)
     gap = face - path[:, 0]  # centre to wall face
     assert gap.min() >= base.AGENT_RADIUS - TOLERANCE
@@ -235,7 +235,7 @@ def test_the_agent_slides_along_a_wall_as_slowly_as_in_vizdoom(angle, vizdoom_sl
     # slid momentum a tic (P_SlideMove's FUDGE), so the agent slides at 74% of the speed friction
     # alone leaves. ViZDoom's steady slide, map units a step (python tools/doom_motion.py --wall-slide).
     env = load("two_colour", complexity=0, item_cap=0)
-    env.task.health = 10**6
+    env.task.state["health"][0] = 10**6
     face = 5.0  # the outer wall's face is the maze's edge
     place(env, 0.0, face - 0.3, math.radians(90 - angle))  # toward the north wall, angle east of its normal
     path = push(env, FORWARD, 12)[3::4]  # the agent's place after each step
@@ -287,7 +287,7 @@ def test_the_tic_it_meets_a_wall_the_agent_keeps_only_the_rest_of_its_move():
     # normal, the next step slides 14.3 map units in ViZDoom where the speed before gave 26.0
     # (python tools/doom_motion.py --wall-slide); keeping all the slid speed gave 24.7.
     env = load("two_colour", complexity=0, item_cap=0)
-    env.task.health = 10**6
+    env.task.state["health"][0] = 10**6
     face = 5.0  # the outer wall's face is the maze's edge
     place(env, 0.0, face - 48 * doom.MAP_UNIT, math.radians(90 - 70))
     along = np.diff(push(env, FORWARD, 7)[3::4, 0]) / doom.MAP_UNIT  # per step, from the first step's end
@@ -336,7 +336,7 @@ def test_items_cover_the_floor_the_agent_can_stand_on():
     for _ in range(30):
         env.reset()
         task, config = env.task, env.task.config
-        xy = task.item_xy[task.item_active]
+        xy = task.state["object_xy"][0, 1:][task.state["object_shown"][0, 1:]]
         # Where the released script's Spawn succeeds: the armour's square clear of walls and the totem's.
         assert (clearance_from_walls(config, xy) >= two_colour.ITEM_RADIUS).all()
         assert (np.abs(xy).max(axis=1) >= two_colour.ITEM_TOTEM_CLEARANCE).all()  # the totem is at the origin

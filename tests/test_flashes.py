@@ -71,12 +71,12 @@ def test_each_lava_hit_flashes_the_view_red_for_two_steps():
 
 
 def _lone_item(task, green):
-    active = np.flatnonzero(task.item_active & (task.item_green == green))
-    everyone = np.flatnonzero(task.item_active)
+    active = np.flatnonzero(task.state["object_shown"][0, 1:] & (two_colour.ITEM_GREEN == green))
+    everyone = np.flatnonzero(task.state["object_shown"][0, 1:])
     for k in active:
         others = everyone[everyone != k]
-        if (np.linalg.norm(task.item_xy[others] - task.item_xy[k], axis=1) > 0.7).all():
-            return task.item_xy[k].copy()
+        if (np.linalg.norm(task.state["object_xy"][0, 1:][others] - task.state["object_xy"][0, 1:][k], axis=1) > 0.7).all():
+            return task.state["object_xy"][0, 1:][k].copy()
     raise AssertionError("no isolated item")
 
 
@@ -84,13 +84,13 @@ def test_a_wrong_item_flashes_red_and_gold_a_right_one_gold():
     envs = twins("two_colour", complexity=1)
     task = envs[0].task
     # Standing on it at the step's first tic: 3 more tics count down before the frame.
-    flashed, plain = step_both(envs, xy=_lone_item(task, not task.totem_green))
-    damage = two_colour.WRONG_RED_DAMAGE if task.totem_green else two_colour.WRONG_GREEN_DAMAGE
-    assert task.health == 92 - damage
+    flashed, plain = step_both(envs, xy=_lone_item(task, not bool(task.state["totem_green"][0])))
+    damage = two_colour.WRONG_RED_DAMAGE if bool(task.state["totem_green"][0]) else two_colour.WRONG_GREEN_DAMAGE
+    assert int(task.state["health"][0]) == 92 - damage
     assert counts(envs[0]) == (damage - 3, 6 - 3)  # the count is the damage the armour let through
     assert np.array_equal(flashed, tinted(plain, damage - 3, 3))
-    flashed, plain = step_both(envs, xy=_lone_item(task, task.totem_green))
-    assert task.health == min(92 - damage + two_colour.ITEM_HEALTH, 100)
+    flashed, plain = step_both(envs, xy=_lone_item(task, bool(task.state["totem_green"][0])))
+    assert int(task.state["health"][0]) == min(92 - damage + two_colour.ITEM_HEALTH, 100)
     assert counts(envs[0]) == (damage - 3 - 4, 6 - 3)  # healing does not flash red; the red fades on
     assert np.array_equal(flashed, tinted(plain, damage - 7, 3))
 

@@ -116,7 +116,7 @@ def test_train_and_test_are_draws_of_one_distribution(scenario, kwargs):
 
     task = suite.make_task(scenario, kwargs)
     counts = {
-        split: [interior_walls(c) for c in configs.ConfigSet(task.scenario, task.configs.difficulty, split, task.layout, 1024)]
+        split: [interior_walls(c) for c in configs.ConfigSet(task.rules.scenario, task.rules.configs.difficulty, split, task.rules.layout, 1024)]
         for split in configs.SPLITS
     }
     assert ks_2samp(counts["train"], counts["test"]).pvalue > 0.01
@@ -126,7 +126,7 @@ def test_two_colour_splits_hold_the_empty_maze_alike():
     # Complexity 1: about 18% of draws are the empty maze; a split by walls put all of them in train.
     task = suite.make_task("two_colour", {"complexity": 1})
     for split in configs.SPLITS:
-        empty = np.mean([interior_walls(c) == 0 for c in configs.ConfigSet("two_colour", 1, split, task.layout, 1024)])
+        empty = np.mean([interior_walls(c) == 0 for c in configs.ConfigSet("two_colour", 1, split, task.rules.layout, 1024)])
         assert 0.13 < empty < 0.23, (split, empty)
 
 
@@ -137,7 +137,7 @@ def test_complexity_zero_builds_both_splits():
         env = mjmaze.load("two_colour", task_kwargs={"complexity": 0, "split": split})
         env.reset()
         assert interior_walls(env.task.config) == 0
-        keys[split] = {c.config_key() for c in env.task.configs}
+        keys[split] = {c.config_key() for c in env.task.rules.configs}
         assert len(keys[split]) > 1
     assert not keys["train"] & keys["test"]
 

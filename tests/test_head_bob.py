@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from mjmaze import doom, look, mjcf
+from mjmaze import doom, look, mjcf, suite
 from mjmaze.tasks import base, two_colour
 
 # Actions as ViZDoom played them: forward 12 steps, nothing 8, forward 15, nothing 10.
@@ -37,9 +37,9 @@ def open_room(head_bob=None, width=320, height=180):
     """A 10 m room without inner walls or items, the agent at its south end facing north, clear of the totem."""
     bob = {} if head_bob is None else {"head_bob": head_bob}  # None: the default
     # ViZDoom's probe room had the pistol and no damaging floor: no flashes, the pistol drawn.
-    task = base.task_class(two_colour.TwoColour)(complexity=0, item_cap=0, width=width, height=height, random=0,
-                                                 flashes=False, **bob)
-    task.pistol = True
+    task = suite.make_task("two_colour", {"complexity": 0, "item_cap": 0, "width": width, "height": height,
+                                          "random": 0, "flashes": False, **bob})
+    task.rules.pistol = True
     env = base.make_environment(task)
     env.reset()
     # ViZDoom's start was (0, -500) facing 90 in the same room without the totem (at the centre here).
@@ -131,4 +131,4 @@ def test_head_bob_is_on_by_default_and_off_keeps_the_view_still():
 
 def test_head_bob_must_be_a_bool():
     with pytest.raises(ValueError, match="head_bob must be True or False"):
-        two_colour.TwoColour(head_bob="yes")
+        suite.make_task("two_colour", {"head_bob": "yes"})

@@ -52,7 +52,7 @@ def write(path, data):
 def test_round_trip_gives_the_same_configuration(tmp_path, scenario, kwargs):
     env = mjmaze.load(scenario, task_kwargs=kwargs)
     for index in range(5):
-        original = env.task.configs[index]
+        original = env.task.rules.configs[index]
         imported = layouts.from_paper_json(write(tmp_path / f"{index}.json", to_paper_json(original, scenario)), scenario)
         assert np.array_equal(imported.h_walls, original.h_walls)
         assert np.array_equal(imported.v_walls, original.v_walls)
@@ -62,7 +62,7 @@ def test_round_trip_gives_the_same_configuration(tmp_path, scenario, kwargs):
 
 
 def test_k_item_kinds_follow_colour_codes_not_list_order(tmp_path):
-    original = mjmaze.load("k_item", task_kwargs={"num_items": 2}).task.configs[0]
+    original = mjmaze.load("k_item", task_kwargs={"num_items": 2}).task.rules.configs[0]
     # The released K = 2 files list red before green; green is still collected first.
     path = write(tmp_path / "k2.json", to_paper_json(original, "k_item", item_order=[1, 0]))
     data = json.loads(path.read_text())
@@ -72,7 +72,7 @@ def test_k_item_kinds_follow_colour_codes_not_list_order(tmp_path):
 
 
 def test_long_wall_segments_cover_every_cell_they_span(tmp_path):
-    original = mjmaze.load("labyrinth", task_kwargs={"size": 5}).task.configs[0]
+    original = mjmaze.load("labyrinth", task_kwargs={"size": 5}).task.rules.configs[0]
     data = to_paper_json(original, "labyrinth")
     edge = 2.5 * UNITS
     data["walls"] = [w for w in data["walls"] if not (abs(w[1]) == edge == abs(w[3]) or abs(w[0]) == edge == abs(w[2]))]
@@ -92,7 +92,7 @@ def test_long_wall_segments_cover_every_cell_they_span(tmp_path):
     ],
 )
 def test_a_malformed_file_names_the_file_and_the_field(tmp_path, mutate, field):
-    data = to_paper_json(mjmaze.load("labyrinth", task_kwargs={"size": 5}).task.configs[0], "labyrinth")
+    data = to_paper_json(mjmaze.load("labyrinth", task_kwargs={"size": 5}).task.rules.configs[0], "labyrinth")
     mutate(data)
     path = write(tmp_path / "broken_07.json", data)
     with pytest.raises(layouts.LayoutError) as error:
@@ -101,7 +101,7 @@ def test_a_malformed_file_names_the_file_and_the_field(tmp_path, mutate, field):
 
 
 def test_unknown_colour_code_and_bad_json(tmp_path):
-    data = to_paper_json(mjmaze.load("k_item", task_kwargs={"num_items": 2}).task.configs[0], "k_item")
+    data = to_paper_json(mjmaze.load("k_item", task_kwargs={"num_items": 2}).task.rules.configs[0], "k_item")
     data["items"][0][2] = "purple"
     with pytest.raises(layouts.LayoutError, match="'items'"):
         layouts.from_paper_json(write(tmp_path / "k.json", data), "k_item")
@@ -111,11 +111,11 @@ def test_unknown_colour_code_and_bad_json(tmp_path):
 
 
 def test_a_task_plays_a_folder_of_paper_layouts(tmp_path):
-    source = mjmaze.load("labyrinth", task_kwargs={"size": 5, "split": "test"}).task.configs
+    source = mjmaze.load("labyrinth", task_kwargs={"size": 5, "split": "test"}).task.rules.configs
     for index in range(3):
         write(tmp_path / f"config_{index:03d}.json", to_paper_json(source[index], "labyrinth"))
     env = mjmaze.load("labyrinth", task_kwargs={"size": 5, "layouts": str(tmp_path)})
-    assert len(env.task.configs) == 3
+    assert len(env.task.rules.configs) == 3
     for index in (0, 1, 2, 0):
         env.reset()
         assert env.task.config.layout_key() == source[index].layout_key()
@@ -124,14 +124,14 @@ def test_a_task_plays_a_folder_of_paper_layouts(tmp_path):
 
 
 def test_a_folder_of_the_wrong_size_is_refused(tmp_path):
-    config = mjmaze.load("labyrinth", task_kwargs={"size": 7}).task.configs[0]
+    config = mjmaze.load("labyrinth", task_kwargs={"size": 7}).task.rules.configs[0]
     write(tmp_path / "a.json", to_paper_json(config, "labyrinth"))
     with pytest.raises(ValueError, match="7x7"):
         mjmaze.load("labyrinth", task_kwargs={"size": 9, "layouts": tmp_path})
 
 
 def test_layouts_that_are_not_a_folder_of_mazes_say_what_to_pass(tmp_path):
-    config = mjmaze.load("labyrinth", task_kwargs={"size": 5}).task.configs[0]
+    config = mjmaze.load("labyrinth", task_kwargs={"size": 5}).task.rules.configs[0]
     single = write(tmp_path / "custom_scenario000.json", to_paper_json(config, "labyrinth"))
     (tmp_path / "empty").mkdir()
     for where, problem in ((tmp_path / "missing", "no such folder"), (single, "a file, not a folder"),

@@ -15,7 +15,7 @@ import pytest
 
 import mjmaze
 
-from mjmaze import compiled_light, look, mjcf, palette, render, sprites, viz
+from mjmaze import compiled_light, look, mjcf, palette, render, sprites, suite, viz
 from mjmaze.doom import FIRST_OBSERVATION_TIC
 from mjmaze.group import EnvGroup
 from mjmaze.tasks import base, find_return, k_item, labyrinth, two_colour
@@ -30,13 +30,13 @@ CLOSE = 9
 def empty_room(room: palette.Room, first_item: mjcf.ObjectGeom | None = None):
     """A 10 m arena without walls inside (Two-colour at complexity 0) coloured as ``room``, objects
     hidden; ``first_item`` replaces its first item."""
-    task = base.task_class(two_colour.TwoColour)(complexity=0, item_cap=0, random=0)
-    task.room = room
+    task = suite.make_task("two_colour", {"complexity": 0, "item_cap": 0, "random": 0})
+    task.rules.room = room
     if first_item is not None:
-        task.objects = (two_colour.TOTEM, first_item, *two_colour.ITEMS[1:])
+        task.rules.objects = (two_colour.TOTEM, first_item, *two_colour.ITEMS[1:])
     env = base.make_environment(task)
     env.reset()
-    env.physics.show_objects(env.physics.object_ids([o.name for o in task.objects])[1], False)
+    env.physics.show_objects(env.physics.object_ids([o.name for o in task.rules.objects])[1], False)
     return env
 
 
@@ -134,7 +134,7 @@ def test_two_colour_walls_are_the_released_grey_stone2():
     # GSTONE1: a Two-colour wall is as grey as Labyrinth's (ViZDoom: 38 grey 1 m ahead).
     env = mjmaze.load("two_colour", task_kwargs={"complexity": 0, "random": 0})
     env.reset()
-    env.physics.show_objects(env.physics.object_ids([o.name for o in env.task.objects])[1], False)
+    env.physics.show_objects(env.physics.object_ids([o.name for o in env.task.rules.objects])[1], False)
     red, green, blue = wall_colour(env, 1.0)
     env.task.close()
     assert (red, green, blue) == pytest.approx((38, 38, 38), abs=CLOSE)
@@ -269,10 +269,10 @@ def test_an_item_spawned_in_play_blinks_from_its_spawn_and_map_things_out_of_ste
     # starts then, whole. The released maps' things (K-item's items, Labyrinth's
     # exit) start with a random 1..6 tics of their first frame left (Doom's
     # P_SpawnMapThing), so K-item's two armours blink out of step in some mazes.
-    task = base.task_class(two_colour.TwoColour)(complexity=0, random=0)
-    start = task.animation_start(np, np.zeros(1, dtype=np.int64))[0]
+    task = suite.make_task("two_colour", {"complexity": 0, "random": 0})
+    start = task.rules.animation_start(np, np.zeros(1, dtype=np.int64))[0]
     assert start[:22].tolist() == [0] * 22 and start[22:25].tolist() == [30, 60, 90]  # the totem, then the items
-    kitem = base.task_class(k_item.KItem)(num_items=4, random=0)
+    kitem = k_item.KItem(num_items=4)
     starts = kitem.animation_start(np, np.arange(200, dtype=np.int64))  # green, blue armour, medikit, soulsphere
     for armour in (0, 1):
         assert sorted(set(starts[:, armour].tolist())) == [-5, -4, -3, -2, -1, 0]
@@ -389,7 +389,7 @@ def test_maps_and_the_flat_style_show_a_sprite_in_its_mean_colour(scenario):
     env = mjmaze.load(scenario, task_kwargs={"random": 0, "visual_style": "flat"})
     env.reset()
     model = env.physics.model
-    for obj in env.task.objects:
+    for obj in env.task.rules.objects:
         if obj.sprite is not None:  # a cylinder in the picture's mean colour, no texture
             geom = env.physics.object_ids([obj.name])[1][0]
             assert model.geom_type[geom] == mujoco.mjtGeom.mjGEOM_CYLINDER
@@ -399,11 +399,11 @@ def test_maps_and_the_flat_style_show_a_sprite_in_its_mean_colour(scenario):
     env.reset()
     top_down = viz.TopDown(env, size=128)
     image = top_down.render()
-    shown = [obj for obj, geom in zip(env.task.objects, env.physics.object_ids([o.name for o in env.task.objects])[1])
+    shown = [obj for obj, geom in zip(env.task.rules.objects, env.physics.object_ids([o.name for o in env.task.rules.objects])[1])
              if obj.sprite is not None and env.physics.model.geom_group[geom] != render.HIDDEN_GROUP]
     assert shown
     for obj in shown:  # lying on the floor, face up, in its mean colour
-        cx, cy = top_down.to_pixels(env.task.state["object_xy"][0][env.task.objects.index(obj)])
+        cx, cy = top_down.to_pixels(env.task.state["object_xy"][0][env.task.rules.objects.index(obj)])
         patch = image[int(cy) - 2:int(cy) + 3, int(cx) - 2:int(cx) + 3].reshape(-1, 3).astype(float)
         mean = np.array(sprites.mean_colour(obj.sprite)) * 255
         assert np.min(np.abs(patch - patch.mean(axis=0)).sum(axis=1)) >= 0  # drawn pixels exist
@@ -456,7 +456,7 @@ def test_find_return_pillars_are_doom_columns():
 def test_the_pistol_when_asked_for_hides_a_floor_item_right_ahead():
     # No scenario draws it (the released maps clear the inventory); a task can (ViZDoom's own maps show it).
     env = mjmaze.load("labyrinth", task_kwargs={"size": 5, "random": 0})
-    env.task.pistol = True
+    env.task.rules.pistol = True
     env.task.close()  # the renderer is made again, with the pistol
     env.reset()
     physics = env.physics

@@ -43,20 +43,20 @@ def _paths(state, step: int) -> np.ndarray:
 @pytest.mark.parametrize("scenario", list(SETTINGS))
 def test_rules_compile_whole_and_match_numpy(scenario):
     task = suite.make_task(scenario, SETTINGS[scenario])
-    configs = [task.configs[i % len(task.configs)] for i in range(NUM_ENVS)]
-    table = task.config_arrays(configs)
+    configs = [task.rules.configs[i % len(task.rules.configs)] for i in range(NUM_ENVS)]
+    table = task.rules.config_arrays(configs)
     keys = np.arange(NUM_ENVS, dtype=np.int64) * 7919 + 1
     tnp = rules.namespace(torch.zeros(1))
-    start = torch.compile(lambda config, k: task.start_state(tnp, config, k), fullgraph=True, backend="eager")
-    step = torch.compile(lambda state, path: task.step_state(tnp, state, path), fullgraph=True, backend="eager")
+    start = torch.compile(lambda config, k: task.rules.start_state(tnp, config, k), fullgraph=True, backend="eager")
+    step = torch.compile(lambda state, path: task.rules.step_state(tnp, state, path), fullgraph=True, backend="eager")
 
-    on_numpy = task.start_state(np, {name: value.copy() for name, value in table.items()}, keys)
+    on_numpy = task.rules.start_state(np, {name: value.copy() for name, value in table.items()}, keys)
     on_torch = start({name: torch.as_tensor(value) for name, value in table.items()}, torch.as_tensor(keys))
     _assert_same(on_numpy, on_torch, "start")
     rewards_seen = 0
     for k in range(STEPS):
         path = _paths(on_numpy, k)
-        expected = task.step_state(np, on_numpy, path)
+        expected = task.rules.step_state(np, on_numpy, path)
         got = step(on_torch, torch.as_tensor(path))
         for name, a, b in zip(("reward", "terminated", "truncated"), expected, got):
             np.testing.assert_array_equal(a, b.numpy(), err_msg=f"{name} at step {k}")

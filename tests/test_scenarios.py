@@ -157,7 +157,7 @@ def test_totem_colour_is_drawn_per_episode_and_shown():
     colours = []
     for _ in range(40):
         env.reset()
-        colours.append(env.task.totem_green)
+        colours.append(bool(env.task.state["totem_green"][0]))
     assert 10 < sum(colours) < 30
     _, (totem,) = env.physics.object_ids([two_colour.TOTEM.name])
     totem_rgba = env.physics.model.geom_rgba[totem]
@@ -170,16 +170,16 @@ def test_eleven_green_and_ten_red_items_start_and_one_more_every_thirty_tics_red
     # observation; the timer's next is red, at tic 30, then green at tic 60, ...
     env = load("two_colour", complexity=3)
     task = env.task
-    assert task.item_active.sum() == 21
-    assert task.item_green[:21].sum() == 11
+    assert task.state["object_shown"][0, 1:].sum() == 21
+    assert two_colour.ITEM_GREEN[:21].sum() == 11
     counts = []
     for _ in range(30):
         env.step(TURN_LEFT)
-        counts.append(task.items_spawned)
+        counts.append(int(task.state["items_spawned"][0]))
     # Tic 4k after k steps: item 22 at tic 30 (step 8), item 23 at tic 60 (step 15), ...
     assert counts[6] == 21 and counts[7] == 22 and counts[13] == 22 and counts[14] == 23
     assert counts[-1] == 21 + (30 * 4) // 30
-    assert list(task.item_green[21:25]) == [False, True, False, True]  # red first, colours alternate
+    assert list(two_colour.ITEM_GREEN[21:25]) == [False, True, False, True]  # red first, colours alternate
 
 
 def test_no_item_cap_by_default_and_an_optional_cap_of_60():
@@ -187,25 +187,25 @@ def test_no_item_cap_by_default_and_an_optional_cap_of_60():
     capped = load("two_colour", complexity=1, item_cap=60)
     for _ in range(300):  # tic 1200: 21 + 40 items due; spinning in place
         for env in (uncapped, capped):
-            env.task.health = 100  # keep the agent alive
+            env.task.state["health"][0] = 100  # keep the agent alive
             env.step(TURN_LEFT)
-    assert uncapped.task.items_spawned == 61
+    assert int(uncapped.task.state["items_spawned"][0]) == 61
     for _ in range(100):
         for env in (uncapped, capped):
-            env.task.health = 100
+            env.task.state["health"][0] = 100
             env.step(TURN_LEFT)
-    assert uncapped.task.items_spawned == 21 + (400 * 4) // 30  # 74: no cap
-    assert capped.task.items_spawned == 60
+    assert int(uncapped.task.state["items_spawned"][0]) == 21 + (400 * 4) // 30  # 74: no cap
+    assert int(capped.task.state["items_spawned"][0]) == 60
 
 
 def test_pool_covers_a_full_episode():
     env = load("two_colour", complexity=1)
     for _ in range(base.EPISODE_STEPS - 1):
-        env.task.health = 100
+        env.task.state["health"][0] = 100
         env.step(TURN_LEFT)
     timestep = env.step(TURN_LEFT)
     assert timestep.last() and timestep.discount == 1.0
-    assert env.task.items_spawned == two_colour.POOL_SIZE == 91
+    assert int(env.task.state["items_spawned"][0]) == two_colour.POOL_SIZE == 91
     assert env.task.metrics()["duration"] == 2100
 
 
@@ -213,11 +213,11 @@ def test_the_floor_takes_8_health_every_32_tics_and_reaching_zero_ends_the_episo
     # As ViZDoom plays the released maze (python tools/doom_frames.py --flashes):
     # 92 at the first frame, 84 from tic 23, 76 from tic 55, ...
     env = load("two_colour", complexity=5)
-    assert env.task.health == 92
+    assert int(env.task.state["health"][0]) == 92
     health = {}
     for step in range(1, 95):
         timestep = env.step(TURN_LEFT)  # spinning never touches an item
-        health[step * 4] = env.task.health
+        health[step * 4] = int(env.task.state["health"][0])
         if step < 94:
             assert timestep.mid() and timestep.reward == pytest.approx(0.04)
     assert (health[20], health[24], health[52], health[56]) == (92, 84, 84, 76)
@@ -230,10 +230,10 @@ def test_the_floor_takes_8_health_every_32_tics_and_reaching_zero_ends_the_episo
 
 def _lone_item(task, green):
     """An active item of that colour with no other item within 0.7 m (one pick-up at a time)."""
-    for k in np.flatnonzero(task.item_active & (task.item_green == green)):
-        others = np.delete(np.flatnonzero(task.item_active), np.flatnonzero(np.flatnonzero(task.item_active) == k))
-        if (np.linalg.norm(task.item_xy[others] - task.item_xy[k], axis=1) > 0.7).all():
-            return task.item_xy[k]
+    for k in np.flatnonzero(task.state["object_shown"][0, 1:] & (two_colour.ITEM_GREEN == green)):
+        others = np.delete(np.flatnonzero(task.state["object_shown"][0, 1:]), np.flatnonzero(np.flatnonzero(task.state["object_shown"][0, 1:]) == k))
+        if (np.linalg.norm(task.state["object_xy"][0, 1:][others] - task.state["object_xy"][0, 1:][k], axis=1) > 0.7).all():
+            return task.state["object_xy"][0, 1:][k]
     raise AssertionError("no isolated item")
 
 
@@ -245,15 +245,15 @@ def pick(env, green):
 def test_correct_item_raises_health_and_pays_wrong_one_costs_health():
     env = load("two_colour", complexity=1)
     task = env.task
-    assert task.health == 92  # the floor's first 8 are taken; its next hit is 23 tics in (step 6)
-    timestep = pick(env, task.totem_green)
-    assert task.health == 100  # +25 capped at 100
+    assert int(task.state["health"][0]) == 92  # the floor's first 8 are taken; its next hit is 23 tics in (step 6)
+    timestep = pick(env, bool(task.state["totem_green"][0]))
+    assert int(task.state["health"][0]) == 100  # +25 capped at 100
     assert timestep.reward == pytest.approx(0.04 + 1.0)
-    timestep = pick(env, not task.totem_green)
-    assert task.health < 100
+    timestep = pick(env, not bool(task.state["totem_green"][0]))
+    assert int(task.state["health"][0]) < 100
     assert timestep.reward == pytest.approx(0.04)
-    timestep = pick(env, task.totem_green)
-    assert task.health == 100
+    timestep = pick(env, bool(task.state["totem_green"][0]))
+    assert int(task.state["health"][0]) == 100
     assert timestep.reward == pytest.approx(0.04 + 1.0)
 
 
@@ -264,9 +264,9 @@ def test_a_wrong_item_costs_25_less_what_its_armour_absorbs():
     task, cost = env.task, {}
     while len(cost) < 2:
         env.reset()
-        task.health = 100
-        pick(env, not task.totem_green)
-        cost["red" if task.totem_green else "green"] = 100 - task.health
+        task.state["health"][0] = 100
+        pick(env, not bool(task.state["totem_green"][0]))
+        cost["red" if bool(task.state["totem_green"][0]) else "green"] = 100 - int(task.state["health"][0])
     assert cost == {"green": 17, "red": 13}
     assert (two_colour.WRONG_GREEN_DAMAGE, two_colour.WRONG_RED_DAMAGE) == (17, 13)
 
@@ -275,11 +275,11 @@ def test_no_item_reward_at_full_health_and_the_reward_is_an_argument():
     env = load("two_colour", complexity=1, correct_item_reward=0.1)
     task = env.task
     env.step(TURN_LEFT)
-    task.health = 100
-    timestep = pick(env, task.totem_green)
+    task.state["health"][0] = 100
+    timestep = pick(env, bool(task.state["totem_green"][0]))
     assert timestep.reward == pytest.approx(0.04)  # health could not rise
-    task.health = 99
-    timestep = pick(env, task.totem_green)
+    task.state["health"][0] = 99
+    timestep = pick(env, bool(task.state["totem_green"][0]))
     assert timestep.reward == pytest.approx(0.04 + 0.1)
 
 
@@ -297,7 +297,7 @@ def test_totem_blocks_movement():
     env = load("two_colour", complexity=0)
     place(env, -0.8, 0.0, 0.0)  # the totem stands at the maze centre
     for _ in range(5):
-        env.task.health = 100
+        env.task.state["health"][0] = 100
         env.step(FORWARD)
     assert env.physics.agent_pose()[0] == pytest.approx(-0.25, abs=0.01)
 
@@ -311,9 +311,9 @@ def test_complexity_out_of_range_is_a_clear_error():
 def test_items_do_not_block_movement():
     env = load("two_colour", complexity=0)
     task = env.task
-    task.item_xy[0] = (-0.8, 0.5)
+    task.state["object_xy"][0, 1:][0] = (-0.8, 0.5)
     (item,), _ = env.physics.object_ids([two_colour.ITEMS[0].name])
-    env.physics.place_objects(item, task.item_xy[0])
+    env.physics.place_objects(item, task.state["object_xy"][0, 1:][0])
     place(env, -1.4, 0.5, 0.0)
     for _ in range(6):  # about 1 m from rest
         env.step(FORWARD)

@@ -166,7 +166,7 @@ def test_flashes_tint_every_world_as_the_cpu_task():
 def test_a_released_layout_that_spawns_on_the_totem_spot(tmp_path):
     # The released Two-colour generator could put the spawn in the totem's cell:
     # that episode has no totem, nothing to see or to bump into (its collision twin in Warp).
-    config = mjmaze.load("two_colour", task_kwargs={"complexity": 1}).task.configs[0]
+    config = mjmaze.load("two_colour", task_kwargs={"complexity": 1}).task.rules.configs[0]
     centre = [v * 128 for v in config.cell_centre(config.object_cells[0])]
     half = config.size * config.cell_size / 2 * 128
     exterior = [[-half, -half], [half, -half], [half, half], [-half, half]]
@@ -268,7 +268,7 @@ def test_reached_through_gymnasium_by_one_word():
     )
     assert isinstance(envs, mjwarp.MazeBatchEnv) and envs.single_action_space.n == 5
     obs, info = envs.reset(seed=0)
-    assert set(suite.make_task("k_item", {"num_items": 2}).info_fields()) <= set(info)
+    assert set(suite.make_rules("k_item", {"num_items": 2}).info_fields()) <= set(info)
     envs.close()
     with pytest.raises(ValueError, match="backend"):
         gymnasium.make_vec(mjmaze.GYM_IDS["k_item"], num_envs=2, vectorization_mode="vector_entry_point", backend="tpu")
@@ -316,10 +316,10 @@ def test_outcome_statistics_agree_over_random_episodes(scenario):
         if not np.isnan(warp_metric).any():
             break
     env = mjmaze.load(scenario, task_kwargs=kwargs)
-    num_configs = len(env.task.configs)
+    num_configs = len(env.task.rules.configs)
     cpu_metric, cpu_length = np.zeros(EPISODES), np.zeros(EPISODES)
     for i in range(EPISODES):  # world i's first episode
-        env.task.first_config = i * num_configs // EPISODES % num_configs
+        env.task.rules.first_config = i * num_configs // EPISODES % num_configs
         env.task.reseed(SEED + i)
         env.reset()
         for step in range(base.EPISODE_STEPS):

@@ -42,7 +42,7 @@ import imageio.v3 as iio
 import numpy as np
 
 import mjmaze
-from mjmaze import configs, look, maze, mjcf, palette, sprites, walls
+from mjmaze import configs, look, maze, mjcf, palette, sprites, suite, walls
 from mjmaze.tasks import base, find_return, k_item, two_colour
 
 #: The game data ViZDoom draws with (``--freedoom``): None, the installed ViZDoom's own.
@@ -271,12 +271,12 @@ def exit_figure() -> None:
 
 def empty_arena(room: str, pistol: bool = True):
     """An empty 10 m arena (Two-colour at complexity 0) coloured as ``room``, its objects hidden."""
-    task = base.task_class(two_colour.TwoColour)(complexity=0, item_cap=0, flashes=False)
-    task.room = {"stone": palette.STONE_ROOM, "slime": palette.SLIME_ROOM}[room]
-    task.pistol = pistol  # as the ViZDoom probe beside it (released_game's weapon)
+    task = suite.make_task("two_colour", {"complexity": 0, "item_cap": 0, "flashes": False})
+    task.rules.room = {"stone": palette.STONE_ROOM, "slime": palette.SLIME_ROOM}[room]
+    task.rules.pistol = pistol  # as the ViZDoom probe beside it (released_game's weapon)
     env = base.make_environment(task)
     env.reset()
-    env.physics.show_objects(env.physics.object_ids([o.name for o in task.objects])[1], False)
+    env.physics.show_objects(env.physics.object_ids([o.name for o in task.rules.objects])[1], False)
     return env
 
 

@@ -352,9 +352,9 @@ def motion(name: str, checkout: str, mazes: int = 8, wad: str | None = None) -> 
             physics.set_agent_pose(*_metres(x, y, centre), math.radians(angle))
             physics.data.qvel[:2] = vx * per_tic, vy * per_tic
             physics.turn_held = held
-            physics.command = task.actions[action]
+            physics.command = task.rules.actions[action]
             physics.step(FRAME_SKIP)
-            held = (held + FRAME_SKIP) * (task.actions[action][1] != 0)
+            held = (held + FRAME_SKIP) * (task.rules.actions[action][1] != 0)
             ours = np.array(physics.agent_pose()[:2]) / MAP_UNIT
             start_xy = np.array(_metres(x, y, centre)) / MAP_UNIT
             doom = np.array(_metres(next_x, next_y, centre)) / MAP_UNIT
@@ -583,15 +583,15 @@ def picks(name: str, checkout: str, mazes: int = 32, wad: str | None = None) -> 
     task = env.task
     for _ in range(PLAYS_PER_MAZE * mazes):
         timestep, player = env.reset(), policy.Policy(agent)
-        totem_green = bool(task.totem_green) if task.state["object_shown"][0, 0] else None
-        steps, right, wrong, on_floor = 0, 0, 0, task.item_active.copy()
+        totem_green = bool(bool(task.state["totem_green"][0])) if task.state["object_shown"][0, 0] else None
+        steps, right, wrong, on_floor = 0, 0, 0, task.state["object_shown"][0, 1:].copy()
         while not timestep.last():
             timestep = env.step(player.act(timestep.observation["pixels"]))
             steps += 1
-            taken = on_floor & ~task.item_active
-            right += int((taken & (task.item_green == task.totem_green)).sum())
-            wrong += int((taken & (task.item_green != task.totem_green)).sum())
-            on_floor = task.item_active.copy()
+            taken = on_floor & ~task.state["object_shown"][0, 1:]
+            right += int((taken & (two_colour.ITEM_GREEN == bool(task.state["totem_green"][0]))).sum())
+            wrong += int((taken & (two_colour.ITEM_GREEN != bool(task.state["totem_green"][0]))).sum())
+            on_floor = task.state["object_shown"][0, 1:].copy()
         episodes["mjmaze"].append((totem_green, steps * FRAME_SKIP, right, wrong))
     task.close()
     table = {}
@@ -673,7 +673,7 @@ def blink(name: str, checkout: str, mazes: int = 8, steps: int = 300, wad: str |
     task, physics = env.task, env.physics
     by_geom = {}  # sprite geom id -> (Doom name, its object's index)
     for doom, sprite in kinds.items():
-        for k, obj in enumerate(task.objects):
+        for k, obj in enumerate(task.rules.objects):
             if obj.sprite is sprite:
                 by_geom[int(physics.object_ids([obj.name])[1][0])] = (doom, k)
     for _ in range(mazes):

@@ -40,13 +40,13 @@ class Seeker:
     def act(self, pixels) -> int:
         task = self.env.task
         x, y, yaw = self.env.physics.agent_pose()
-        wanted = task.item_active & ((task.item_green == task.totem_green) | (not self.right_only))
+        wanted = task.state["object_shown"][0, 1:] & ((two_colour.ITEM_GREEN == bool(task.state["totem_green"][0])) | (not self.right_only))
         moved = self.last_xy is None or np.hypot(x - self.last_xy[0], y - self.last_xy[1]) > 0.02
         self.stuck = 0 if moved else self.stuck + 1
         self.last_xy = (x, y)
         if not wanted.any() or self.stuck >= 2:  # nothing to reach, or against a wall: a random step
             return int(self.rng.integers(5))
-        targets = task.item_xy[wanted]
+        targets = task.state["object_xy"][0, 1:][wanted]
         dx, dy = (targets - (x, y)).T
         k = int(np.argmin(dx * dx + dy * dy))
         error = (np.arctan2(dy[k], dx[k]) - yaw + np.pi) % (2 * np.pi) - np.pi
@@ -77,11 +77,11 @@ def main() -> None:
         timestep, task = env.reset(), env.task
         player.reset()
         while not timestep.last():
-            on_floor = task.item_active.copy()
+            on_floor = task.state["object_shown"][0, 1:].copy()
             timestep = env.step(player.act(timestep.observation["pixels"]))
-            green = task.item_green[on_floor & ~task.item_active]
-            right += int((green == task.totem_green).sum())
-            wrong += int((green != task.totem_green).sum())
+            green = two_colour.ITEM_GREEN[on_floor & ~task.state["object_shown"][0, 1:]]
+            right += int((green == bool(task.state["totem_green"][0])).sum())
+            wrong += int((green != bool(task.state["totem_green"][0])).sum())
         durations.append(task.metrics()["duration"])
     print(f"{mode}: {episodes} episodes, {np.mean(durations):.0f} tics survived, "
           f"{right / episodes:.2f} right and {wrong / episodes:.2f} wrong items per episode")

@@ -1,17 +1,16 @@
 """A scenario as a dm_control task: one env's episodes, physics and frames.
 
-:class:`MazeTask` joins a scenario's core (:class:`mjmaze.core.MazeRules`: its
-settings, mazes and batched rules) to dm_control's ``Task``: it picks each
-episode's maze and draws from the env's seed and reports the time limit; its
-rules' state, physics and frames are a group of one
-(:class:`mjmaze.group.EnvGroup`, which a vector env's process steps with many). A scenario written as a ``MazeRules`` subclass gets its task from
-:func:`task_class`; one written as a ``MazeTask`` subclass is its own.
+:class:`MazeTask` is dm_control's ``Task`` around a scenario's core (its
+``rules``, a :class:`mjmaze.core.MazeRules`: settings, mazes and batched
+rules) and its frames' look (its ``view``, a :class:`mjmaze.look.View`): it
+picks each episode's maze and draws from the env's seed and reports the time
+limit; its rules' state, physics and frames are a group of one
+(:class:`mjmaze.group.EnvGroup`, which a vector env's process steps with many).
 """
 
 from __future__ import annotations
 
 import collections
-import functools
 import math
 
 import numpy as np
@@ -19,11 +18,12 @@ from dm_control.rl import control
 from dm_control.suite import base
 from dm_env import specs
 
-from mjmaze import configs, core, doom, mjcf, rules
+from mjmaze import configs, core, doom, look, mjcf
+from mjmaze.rules import seed_key
 from mjmaze.group import EnvGroup
 # The timing, motion and action names scenario code and tests read as base.*.
 from mjmaze.core import (  # noqa: F401
-    ACTION_NAMES, ACTION_SETS, AGENT_RADIUS, DEFAULT_HEIGHT, DEFAULT_WIDTH, EPISODE_STEPS, STEPS_PER_SECOND,
+    ACTION_NAMES, ACTION_SETS, AGENT_RADIUS, EPISODE_STEPS, STEPS_PER_SECOND,
 )
 from mjmaze.physics import (  # noqa: F401
     FORWARD_PER_STEP, FRICTION, SLOW_TURN_TICS, THRUST_PER_TIC, TURN_PER_STEP, TURN_PER_TIC, VISIBLE_GROUP,
@@ -33,16 +33,19 @@ from mjmaze.physics import (  # noqa: F401
 CAMERA = mjcf.EGO_CAMERA
 
 
-class MazeTask(core.MazeRules, base.Task):
+class MazeTask(base.Task):
     """A scenario as a dm_control task: one env, a group of one (:class:`mjmaze.group.EnvGroup`); see the
-    module docstring."""
+    module docstring. :func:`mjmaze.suite.make_task` makes one from a scenario's task arguments."""
 
-    def __init__(self, *args, random=None, **kwargs):
-        """The scenario's arguments (:class:`mjmaze.core.MazeRules`), and ``random``: a seed or
-        ``numpy.random.RandomState`` for the episodes' draws (dm_control's ``Task`` argument)."""
+    def __init__(self, rules: core.MazeRules, view: look.View | None = None, random=None):
+        """``rules``: the scenario's core; ``view``: how frames look (default: :class:`mjmaze.look.View`'s);
+        ``random``: a seed or ``numpy.random.RandomState`` for the episodes' draws (dm_control's ``Task`` argument)."""
         base.Task.__init__(self, random=random)
-        super().__init__(*args, **kwargs)
-        self._seed_key = rules.seed_key(self.random)
+        #: The scenario's core: its settings, configurations and batched rules.
+        self.rules = rules
+        #: How the frames look: their size, style, head-bob and flashes.
+        self.view = look.View() if view is None else view
+        self._seed_key = seed_key(self.random)
         self._group: EnvGroup | None = None
         #: The ego camera's horizontal field of view in radians (known once the task has a physics).
         self.horizontal_fov = math.nan
@@ -55,7 +58,7 @@ class MazeTask(core.MazeRules, base.Task):
     def reseed(self, seed: int | None) -> None:
         """Restarts the episode sequence: same seed, same episodes."""
         self.random.seed(seed)
-        self._seed_key = rules.seed_key(self.random)
+        self._seed_key = seed_key(self.random)
         if self._group is not None:
             self._group.reseed(0, self._seed_key)
 
@@ -69,7 +72,7 @@ class MazeTask(core.MazeRules, base.Task):
         else:
             episodes = 0 if self._group is None else int(self._group.episodes[0])
             self.close()
-            self._group = EnvGroup(self, [physics], [self._seed_key])
+            self._group = EnvGroup(self.rules, self.view, [physics], [self._seed_key])
             self._group.episodes[0] = episodes
         self._bound_data = data
         self.horizontal_fov = mjcf.EGO_HORIZONTAL_FOV
@@ -92,7 +95,8 @@ class MazeTask(core.MazeRules, base.Task):
     # -- the per-step path ------------------------------------------------
 
     def before_step(self, action, physics: MazePhysics) -> None:
-        physics.command = self.actions[core.check_action(action, len(self.actions))]
+        actions = self.rules.actions
+        physics.command = actions[core.check_action(action, len(actions))]
 
     def after_step(self, physics: MazePhysics) -> None:
         reward, ended, _ = self._group.end_step([0])
@@ -100,7 +104,7 @@ class MazeTask(core.MazeRules, base.Task):
 
     def get_observation(self, physics: MazePhysics) -> collections.OrderedDict:
         self._bind(physics)
-        frame = np.empty((1, self.height, self.width, 3), dtype=np.uint8)
+        frame = np.empty((1, *self.view.frame_shape), dtype=np.uint8)
         self._group.observe(frame, [0])
         return collections.OrderedDict(pixels=frame[0])
 
@@ -129,11 +133,11 @@ class MazeTask(core.MazeRules, base.Task):
     # -- specs and analysis -------------------------------------------------
 
     def action_spec(self, physics: MazePhysics) -> specs.DiscreteArray:
-        return specs.DiscreteArray(len(self.actions), name="action")
+        return specs.DiscreteArray(len(self.rules.actions), name="action")
 
     def observation_spec(self, physics: MazePhysics) -> collections.OrderedDict:
         return collections.OrderedDict(
-            pixels=specs.Array((self.height, self.width, 3), np.uint8, name="pixels")
+            pixels=specs.Array(self.view.frame_shape, np.uint8, name="pixels")
         )
 
     @property
@@ -144,8 +148,8 @@ class MazeTask(core.MazeRules, base.Task):
     def metrics(self) -> dict:
         """The scenario's metric fields for ``info``, as Python scalars."""
         if self.state is None:  # before the first episode: what a new episode reports
-            return self.new_episode_metrics()
-        return {name: value[0].item() for name, value in self.episode_metrics(self.state).items()}
+            return self.rules.new_episode_metrics()
+        return {name: value[0].item() for name, value in self.rules.episode_metrics(self.state).items()}
 
     def get_info(self, physics: MazePhysics) -> dict:
         """Metric fields, the agent's pose and where the episode stands."""
@@ -162,31 +166,23 @@ class MazeTask(core.MazeRules, base.Task):
         self._bound_data = None
 
 
-@functools.cache
-def task_class(rules_class: type) -> type:
-    """The dm_control task class of a scenario: ``rules_class`` joined with :class:`MazeTask` (cached: one
-    class per scenario)."""
-    return type(f"{rules_class.__name__}Task", (rules_class, MazeTask), {"__module__": rules_class.__module__,
-                                                               "__doc__": rules_class.__doc__})
-
-
-def make_physics(rules: core.MazeRules, count: int = 1) -> list[MazePhysics]:
+def make_physics(rules: core.MazeRules, view: look.View, count: int = 1) -> list[MazePhysics]:
     """``count`` physics of the scenario's arena (its model built once, compiled for each), the camera's
     projection final."""
-    xml = mjcf.build_xml(rules.layout.grid_size, rules.layout.cell_size, rules.objects, rules.visual_style,
-                         rules.room, width=rules.width)
+    xml = mjcf.build_xml(rules.layout.grid_size, rules.layout.cell_size, rules.objects, view.visual_style,
+                         rules.room, width=view.width)
     made = []
     for _ in range(count):
         physics = MazePhysics.from_xml_string(xml)
-        mjcf.paint_textures(physics.model.ptr, rules.room, rules.objects, rules.width, rules.layout.cell_size)
-        mjcf.set_ego_projection(physics.model.ptr, rules.width, rules.height)
+        mjcf.paint_textures(physics.model.ptr, rules.room, rules.objects, view.width, rules.layout.cell_size)
+        mjcf.set_ego_projection(physics.model.ptr, view.width, view.height)
         made.append(physics)
     return made
 
 
 def make_environment(task: MazeTask, environment_kwargs: dict | None = None) -> control.Environment:
     """Compiles the task's arena and wraps it in a dm_control environment."""
-    physics = make_physics(task)[0]
+    physics = make_physics(task.rules, task.view)[0]
     kwargs = dict(n_sub_steps=doom.TICS_PER_STEP, legacy_step=False)
     kwargs.update(environment_kwargs or {})
     return control.Environment(physics, task, **kwargs)

@@ -112,8 +112,9 @@ ITEM_TOTEM_CLEARANCE = TOTEM_RADIUS + ITEM_RADIUS
 # Where the released map keeps the columns until its script moves one in
 # (4,096 map units west of the centre), and an absent totem stays.
 TOTEM_PARKED_XY = (-4096 * doom.MAP_UNIT, 0.0)
-ITEMS = tuple(mjcf.sprite_thing(f"item_{k}", sprites.GREEN_ARMOUR if k % 2 == 0 else sprites.BLUE_ARMOUR)
-              for k in range(POOL_SIZE))
+ITEM_GREEN = np.arange(POOL_SIZE) % 2 == 0  # the pool's colours, alternating, green first
+ITEMS = tuple(mjcf.sprite_thing(f"item_{k}", sprites.GREEN_ARMOUR if green else sprites.BLUE_ARMOUR)
+              for k, green in enumerate(ITEM_GREEN))
 TOTEM_COLOURS = (tuple(RED), tuple(GREEN))  # by totem_green
 # Per object (the totem, then the pool): the tic its animation starts (TwoColour.animation_start).
 _ANIMATION_START = (0,) * (1 + START_ITEMS) + tuple(SPAWN_EVERY_TICS * j for j in range(1, POOL_SIZE - START_ITEMS + 1))
@@ -293,39 +294,6 @@ class TwoColour(core.MazeRules):
             "health": state["health"],
             "totem_green": state["totem_green"],
         }
-
-    # -- the episode's state, for tests and analysis (batch of one) ----------
-
-    @property
-    def item_xy(self) -> np.ndarray:
-        """``(POOL_SIZE, 2)``: where each item of the pool is (a view: writes move them)."""
-        return self.state["object_xy"][0, 1:]
-
-    @property
-    def item_active(self) -> np.ndarray:
-        """``(POOL_SIZE,)``: which items are on the floor (a view)."""
-        return self.state["object_shown"][0, 1:]
-
-    @property
-    def item_green(self) -> np.ndarray:
-        """``(POOL_SIZE,)``: the items' colours, alternating, green first."""
-        return np.arange(POOL_SIZE) % 2 == 0
-
-    @property
-    def items_spawned(self) -> int:
-        return int(self.state["items_spawned"][0])
-
-    @property
-    def totem_green(self) -> bool:
-        return bool(self.state["totem_green"][0])
-
-    @property
-    def health(self) -> int:
-        return int(self.state["health"][0])
-
-    @health.setter
-    def health(self, value: int) -> None:
-        self.state["health"][0] = value
 
 
 SCENARIO = registry.Scenario(
