@@ -19,7 +19,8 @@ import time
 import mujoco
 
 import mjmaze
-from mjmaze import configs, core, look, mjcf, render, walls
+from mjmaze import configs, render, walls
+from mjmaze.arena import Arena
 from mjmaze.tasks import labyrinth
 
 
@@ -28,11 +29,11 @@ def rss_mb() -> float:
         return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2**20
 
 
-def compile_arena(xml: str, size: int, config: configs.MazeConfig):
+def compile_arena(arena: Arena, config: configs.MazeConfig):
     """A freshly compiled model with ``config``'s walls and its own render context."""
-    model = mujoco.MjModel.from_xml_string(xml)
+    model, ids = arena.compile()
     data = mujoco.MjData(model)
-    layout = walls.WallLayout(model, size, labyrinth.CELL_SIZE)
+    layout = walls.WallLayout(model, ids.wall_boxes, ids.wall_meshes[0], labyrinth.CELL_SIZE)
     layout.apply(config.h_walls, config.v_walls)
     renderer = render.EgoRenderer(model, "ego", 112, 64)
     renderer.upload_mesh(layout.mesh_id)
@@ -58,12 +59,12 @@ def main() -> None:
     pool_ms = 1e3 * (time.perf_counter() - start) / n
     pool_mb = rss_mb() - before
 
-    xml = mjcf.build_xml(size, labyrinth.CELL_SIZE, labyrinth.Labyrinth.objects, width=look.DEFAULT_WIDTH)
+    arena = Arena(env.task.rules, env.task.view)
     before = rss_mb()
     start = time.perf_counter()
     cache = []
     for i in range(n):
-        cache.append(compile_arena(xml, size, config_set[i]))
+        cache.append(compile_arena(arena, config_set[i]))
     build_ms = 1e3 * (time.perf_counter() - start) / n
     cache_mb = rss_mb() - before
     start = time.perf_counter()
@@ -77,7 +78,7 @@ def main() -> None:
     before = rss_mb()
     start = time.perf_counter()
     for i in range(n):
-        model, data, renderer = compile_arena(xml, size, config_set[i])
+        model, data, renderer = compile_arena(arena, config_set[i])
         mujoco.mj_forward(model, data)
         renderer.close()
     reload_ms = 1e3 * (time.perf_counter() - start) / n

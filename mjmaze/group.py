@@ -49,15 +49,15 @@ class EnvGroup:
         models = [p.model.ptr for p in self.physics]
         self._models, self._data = models, [p.data.ptr for p in self.physics]
         self._qpos = [data.qpos for data in self._data]
-        self._walls = [walls.WallLayout(model, rules.layout.grid_size, rules.layout.cell_size) for model in models]
-        self.pipeline = look.FramePipeline(np, "cpu", view, rules, models[0])
+        ids = self.physics[0].arena  # every physics of the group is one arena's
+        self._walls = [walls.WallLayout(model, ids.wall_boxes, ids.wall_meshes[0], rules.layout.cell_size)
+                       for model in models]
+        self.pipeline = look.FramePipeline(np, "cpu", view, rules, models[0], ids)
         self.renderers: list[render.EgoRenderer] = []
         self.open()
-        self._eyes = [model.cam(CAMERA).pos for model in models]  # views into the models: head-bob moves them
-        names = [obj.name for obj in rules.objects]
-        self._object_ids = [p.object_ids(names)[1] for p in self.physics]
-        sprites = self.pipeline.sprites
-        self._sprite_ids = sprites.geom_ids if sprites is not None and len(sprites) else None
+        self._eyes = [model.cam_pos[ids.ego_camera] for model in models]  # views into the models: head-bob moves them
+        self._object_ids = ids.objects
+        self._sprite_ids = ids.sprites if len(ids.sprites) else None
         self._xy_in_model = [np.empty((0, 2))] * count
         self._shown_in_model = [np.empty(0, dtype=bool)] * count
         self._paths = np.zeros((count, doom.TICS_PER_STEP, 2))
@@ -132,7 +132,7 @@ class EnvGroup:
     def sync_objects(self, row: int, everything: bool = False) -> None:
         """Moves, shows, hides, colours row ``row``'s objects as the state says (what changed; ``everything``:
         all of them, colours too)."""
-        state, ids, physics = self.state, self._object_ids[row], self.physics[row]
+        state, ids, physics = self.state, self._object_ids, self.physics[row]
         xy, shown = state["object_xy"][row], state["object_shown"][row]
         if everything:
             self._xy_in_model[row] = np.full_like(xy, np.nan)

@@ -166,19 +166,18 @@ class SpriteView:
     """Doom's sprites in a frame: each item's picture turned to face the camera, at its animation
     frame, lit and averaged as ViZDoom's released frames show it at its depth (:func:`mjmaze.sprites.textures`).
 
-    Made once per model (its sprite geoms, :func:`mjmaze.mjcf.sprite_geoms`)
-    and frame width, on numpy or torch (``xp``, as :mod:`mjmaze.rules`); call
-    it before each render with a batch of worlds.
+    Made once per model (its sprite geoms: an :class:`mjmaze.arena.ArenaIds`'s
+    ``sprites`` and ``sprite_objects``) and frame width, on numpy or torch
+    (``xp``, as :mod:`mjmaze.rules`); call it before each render with a batch of worlds.
     """
 
-    def __init__(self, xp, device, model: mujoco.MjModel, objects: Sequence[mjcf.ObjectGeom], width: int):
+    def __init__(self, xp, device, model: mujoco.MjModel, objects: Sequence[mjcf.ObjectGeom], ids, width: int):
         self._xp = xp
-        geoms = mjcf.sprite_geoms(model, objects)
+        geoms = ids.sprites
         #: ``(n,)`` int64 numpy: the geoms this view turns and pictures.
         self.geom_ids = geoms
-        index_of = {obj.name: k for k, obj in enumerate(objects)}
         #: ``(n,)`` int64 numpy: each geom's object (its index in ``objects``).
-        self.object_index = np.array([index_of[model.geom(int(g)).name] for g in geoms], dtype=np.int64)
+        self.object_index = ids.sprite_objects
         of_geom = [objects[k].sprite for k in self.object_index]
         kinds = list(dict.fromkeys(of_geom))
         # Every kind's animation repeats within the least common multiple of their cycles.
@@ -386,13 +385,14 @@ class FramePipeline:
     every world (:mod:`mjmaze.warp`). Made once per model and device.
     """
 
-    def __init__(self, xp, device, view: View, arena, model: mujoco.MjModel):
+    def __init__(self, xp, device, view: View, arena, model: mujoco.MjModel, ids):
         """``arena``: what the scenario's arena holds (its ``objects``, ``layout``, whether it has a
-        ``pistol``: a :class:`mjmaze.core.MazeRules`)."""
+        ``pistol``: a :class:`mjmaze.core.MazeRules`); ``model`` and ``ids``: the arena compiled
+        (:class:`mjmaze.arena.ArenaIds`)."""
         self._xp, self._device = xp, device
         self._width, self._height = view.width, view.height
         textured = view.textured
-        self.sprites = SpriteView(xp, device, model, arena.objects, view.width) if textured else None
+        self.sprites = SpriteView(xp, device, model, arena.objects, ids, view.width) if textured else None
         self.light = (DoomLight(xp, device, view.width, view.height, arena.layout.grid_size, arena.layout.cell_size)
                       if textured else None)
         # The pistol is drawn where the released runs drew it: in the paper's look.

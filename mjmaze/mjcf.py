@@ -155,14 +155,14 @@ def build_xml(
         arena = ET.SubElement(worldbody, "body", name=ARENA_BODY, mocap="true", pos="0 0 0")
         for layout, quads in enumerate(wall_layout_quads):  # overwritten after compiling (write_wall_mesh)
             walls.add_placeholder_mesh(asset, f"{walls.WALL_MESH}_{layout}", quads)
-        ET.SubElement(arena, "geom", name="walls_visual", type="mesh", mesh=f"{walls.WALL_MESH}_0", material="wall")
+        ET.SubElement(arena, "geom", name=walls.WALL_VISUAL, type="mesh", mesh=f"{walls.WALL_MESH}_0", material="wall")
     else:
         arena = worldbody
         # A placeholder mesh with room for the most quads any maze needs (every
         # segment cut into pieces, all five quads each); WallLayout.apply overwrites
         # it before first use.
         walls.add_placeholder_mesh(asset, walls.WALL_MESH, walls.placeholder_quads(grid_size, cell_size))
-        ET.SubElement(worldbody, "geom", name="walls_visual", type="mesh", mesh=walls.WALL_MESH, material="wall")
+        ET.SubElement(worldbody, "geom", name=walls.WALL_VISUAL, type="mesh", mesh=walls.WALL_MESH, material="wall")
     # The floor after the walls: MuJoCo draws geoms in model order, so floor
     # pixels hidden by walls fail the depth test before any shading.
     half_extent = grid_size * cell_size / 2 + walls.WALL_THICKNESS
@@ -187,7 +187,7 @@ def build_xml(
     )
     for k, (x, y, hx, hy) in enumerate(segments):
         ET.SubElement(
-            arena, "geom", name=f"wall_{k}", **{"class": "wall_collision"},
+            arena, "geom", name=walls.WALL_BOX_NAME.format(k), **{"class": "wall_collision"},
             # Compiled in place: MuJoCo's midphase keeps the world body's
             # geom bounding boxes from compile time, so boxes never move.
             size=f"{hx} {hy} {walls.WALL_HEIGHT / 2}", pos=f"{x} {y} {walls.WALL_HEIGHT / 2}",
@@ -320,20 +320,17 @@ def _ambient_light(root: ET.Element) -> None:
     headlight.set("diffuse", "0 0 0")
 
 
-def paint_textures(model: mujoco.MjModel, room: palette.Room, objects: Sequence[ObjectGeom], width: int,
-                   cell_size: float) -> None:
-    """Fills the textures of a ``"textured"`` model built for ``room``: walls,
+def paint_textures(model: mujoco.MjModel, room: palette.Room, cell_size: float) -> None:
+    """Fills the surface textures of a ``"textured"`` model built for ``room``: walls,
     floor and ceiling (Freedoom's patterns, :func:`surface_texels`; the flats
-    laid for a maze of ``cell_size`` cells as the released maps lay them), and
-    the pictures and meshes of ``objects``' sprites for ``width``-wide frames
-    (:func:`write_sprites`)."""
+    laid for a maze of ``cell_size`` cells as the released maps lay them). The
+    sprites are :func:`write_sprites`'s (:meth:`mjmaze.arena.Arena.finish` does both)."""
     for name in SURFACES:
         texels = surface_texels(getattr(room, f"{name}_texture"), _material_colour(room, name))[0]
         if name != "wall":
             plane = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name)
             texels = _laid_on_the_map(texels, model.geom_size[plane][:2], cell_size / 2, turned_over=name == "ceiling")
         _paint(model, name, texels)
-    write_sprites(model, objects, width)
 
 
 def _laid_on_the_map(texels: np.ndarray, half_size, origin: float, turned_over: bool) -> np.ndarray:
@@ -412,9 +409,9 @@ def _add_sprite(asset: ET.Element, obj: ObjectGeom, width: int) -> tuple[dict, t
             (1.0, 1.0, 1.0, 1.0))
 
 
-def write_sprites(model: mujoco.MjModel, objects: Sequence[ObjectGeom], width: int) -> None:
-    """Writes the pictures and meshes of ``objects``' sprites into a compiled textured model
-    for ``width``-wide frames.
+def write_sprites(model: mujoco.MjModel, objects: Sequence[ObjectGeom], geoms: Sequence[int], width: int) -> None:
+    """Writes the pictures and meshes of ``objects``' sprites, drawn by ``geoms`` (one each), into a
+    compiled textured model for ``width``-wide frames.
 
     A mesh's vertices are written as :func:`mjmaze.sprites.mesh_quads` gives
     them, in the frame of a geom at the object's height (``z``), unrotated
@@ -422,8 +419,7 @@ def write_sprites(model: mujoco.MjModel, objects: Sequence[ObjectGeom], width: i
     is undone.
     """
     written = set()
-    for geom in sprite_geoms(model, objects):
-        obj = next(obj for obj in objects if obj.name == model.geom(int(geom)).name)
+    for obj, geom in zip(objects, geoms):
         model.geom_pos[geom, 2] = obj.z
         model.geom_quat[geom] = (1.0, 0.0, 0.0, 0.0)
         model.geom_rbound[geom] = 0.0  # 0 = never culled by bounding sphere
@@ -449,16 +445,3 @@ def write_sprites(model: mujoco.MjModel, objects: Sequence[ObjectGeom], width: i
         texcoord_adr = model.mesh_texcoordadr[mesh]
         model.mesh_texcoord[texcoord_adr : texcoord_adr + len(texcoords)] = texcoords
         model.mesh_facetexcoord[face_adr : face_adr + len(faces)] = faces
-
-
-def sprite_geoms(model: mujoco.MjModel, objects: Sequence[ObjectGeom]) -> np.ndarray:
-    """Geom ids of ``objects`` drawn as sprites in ``model`` (none in the flat style)."""
-    ids = []
-    for obj in objects:
-        if obj.sprite is not None:
-            geom = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, obj.name)
-            if model.geom_type[geom] == mujoco.mjtGeom.mjGEOM_MESH:
-                ids.append(geom)
-    return np.array(ids, dtype=np.int64)
-
-

@@ -11,12 +11,16 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import mujoco as mj
 import numpy as np
 from dm_control import mujoco
 
 from mjmaze import core, doom, look, mjcf, render
+
+if TYPE_CHECKING:
+    from mjmaze.arena import ArenaIds
 
 # Motion: Doom's player movement, tic by tic (ZDoom's P_MovePlayer and
 # P_XYMovement; measured in ViZDoom, see docs/motion.md). A held forward key
@@ -58,6 +62,8 @@ class MazePhysics(mujoco.Physics):
     turn_held: int = 0
     #: Doom's walking bob (map units) of the last tic: see :func:`mjmaze.look.view_bob`.
     bob: float = 0.0
+    #: The ids of the arena's parts (:class:`mjmaze.arena.ArenaIds`), set by :func:`mjmaze.tasks.base.make_physics`.
+    arena: ArenaIds | None = None
 
     def step(self, nstep: int = 1) -> None:
         """Advances ``nstep`` tics of :attr:`command`; walls and pillars stop the agent at its radius.
@@ -126,19 +132,11 @@ class MazePhysics(mujoco.Physics):
         self.turn_held = 0
         self.bob = 0.0
 
-    def object_ids(self, names: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
-        """``(ids for place_objects, geom ids)`` of scenario objects (see :class:`mjmaze.mjcf.ObjectGeom`).
-
-        Both are the objects' geom ids (the pair keeps scenario code unchanged).
-        Looked up once per list of names (Two-colour asks for 91 at every reset).
-        """
-        key = tuple(names)
-        cache = self.__dict__.setdefault("_object_ids", {})
-        if key not in cache:
-            model = self.model.ptr
-            cache[key] = np.array([mj.mj_name2id(model, mj.mjtObj.mjOBJ_GEOM, name) for name in names], dtype=int)
-        geom_ids = cache[key]
-        return geom_ids.copy(), geom_ids.copy()
+    def object_ids(self, names: Sequence[str]) -> np.ndarray:
+        """The geom ids of objects named ``names`` (see :class:`mjmaze.mjcf.ObjectGeom`), for tools and tests
+        that pick objects by name; the arena's own are in :attr:`arena`."""
+        model = self.model.ptr
+        return np.array([mj.mj_name2id(model, mj.mjtObj.mjOBJ_GEOM, name) for name in names], dtype=int)
 
     def place_objects(self, object_ids, xy) -> None:
         """Moves objects (ids from :meth:`object_ids`) to floor positions ``xy`` (shape ``(n, 2)`` or ``(2,)``).

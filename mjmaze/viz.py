@@ -24,7 +24,7 @@ try:
 except ImportError as error:  # pragma: no cover - depends on the install
     raise ImportError("mjmaze.viz needs Pillow: pip install 'mjmaze[viz]'") from error
 
-from mjmaze import configs, files, mjcf, render, suite, walls
+from mjmaze import configs, files, mjcf, render, suite
 from mjmaze.tasks import base
 
 PATH_COLOUR = (255, 255, 255)
@@ -56,11 +56,12 @@ class TopDown:
         self._renderer = render.EgoRenderer(
             self.physics.model.ptr, mjcf.OVERHEAD_CAMERA, self.size, self.size, map_view=True
         )
-        self._wall_mesh = self.physics.model.ptr.mesh(walls.WALL_MESH).id
-        model = self.physics.model.ptr
-        self._sprite_ids = mjcf.sprite_geoms(model, self.task.rules.objects)
-        by_name = {obj.name: obj for obj in self.task.rules.objects}
-        self._sprite_rgba = np.array([by_name[model.geom(int(g)).name].rgba for g in self._sprite_ids]).reshape(-1, 4)
+        ids = self.physics.arena
+        self._wall_mesh = int(ids.wall_meshes[0])
+        self._object_ids = ids.objects
+        self._sprite_ids = ids.sprites
+        objects = self.task.rules.objects
+        self._sprite_rgba = np.array([objects[k].rgba for k in ids.sprite_objects]).reshape(-1, 4)
 
     def to_pixels(self, xy) -> np.ndarray:
         """Map pixel ``(column, row)`` of world points ``xy`` (shape ``(..., 2)``)."""
@@ -126,8 +127,7 @@ class TopDown:
         kind of object shown now, in its colour on the map (objects named ``item_3`` count as "item")."""
         entries = [("spawn", SPAWN_COLOUR), ("path", PATH_COLOUR), ("agent", AGENT_COLOUR)]
         model = self.physics.model.ptr
-        ids = self.physics.object_ids([obj.name for obj in self.task.rules.objects])[1]
-        for obj, geom in zip(self.task.rules.objects, ids):
+        for obj, geom in zip(self.task.rules.objects, self._object_ids):
             if model.geom_group[geom] == render.HIDDEN_GROUP:
                 continue
             label = re.sub(r"_?\d+$", "", obj.name).replace("_", " ")

@@ -23,6 +23,8 @@ import numpy as np
 WALL_THICKNESS = 0.125
 WALL_HEIGHT = 1.0
 WALL_MESH = "walls"
+WALL_VISUAL = "walls_visual"  # the geom drawing the walls' mesh
+WALL_BOX_NAME = "wall_{}"  # the collision boxes wall_0, wall_1, ... in wall_segments order
 
 # Per wall box in the visual mesh: 4 side faces + the top (the bottom is never
 # seen), each a quad of its own 4 vertices (texture coordinates differ per
@@ -189,33 +191,25 @@ def _wall_mesh(h_walls: bytes, h_shape: tuple, v_walls: bytes, v_shape: tuple, c
 
 
 class WallLayout:
-    """Writes a configuration's walls into a compiled arena model.
+    """Writes a configuration's walls into a compiled CPU arena model (:class:`mjmaze.arena.Arena`).
 
+    ``box_ids``: the wall boxes, in :func:`wall_segments` order; ``mesh_id``: the
+    walls' mesh (an :class:`mjmaze.arena.ArenaIds`'s ``wall_boxes`` and ``wall_meshes[0]``).
     After :meth:`apply`, re-upload mesh :attr:`mesh_id` to every rendering
     context of the model.
     """
 
-    def __init__(self, model: mujoco.MjModel, grid_size: int, cell_size: float):
+    def __init__(self, model: mujoco.MjModel, box_ids: np.ndarray, mesh_id: int, cell_size: float):
         self._model = model
         self._cell_size = cell_size
-        self._segments = wall_segments(grid_size, cell_size)
-        first = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "wall_0")
-        self._box_ids = np.arange(first, first + len(self._segments))
-        self.mesh_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MESH, WALL_MESH)
-        visual = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "walls_visual")
-        # Mesh vertices are written in world coordinates: undo the compiler's
-        # recentring of the placeholder mesh.
-        model.geom_pos[visual] = 0.0
-        model.geom_quat[visual] = (1.0, 0.0, 0.0, 0.0)
-        model.geom_rbound[visual] = 0.0  # 0 = never culled by bounding sphere
-        if model.mesh_vertnum[self.mesh_id] < len(self._segments) * _pieces_per_segment(cell_size) * _BOX_VERTS:
-            raise RuntimeError("the compiled wall mesh is smaller than its placeholder: vertices were merged")
+        self._box_ids = np.asarray(box_ids)
+        self.mesh_id = int(mesh_id)
 
     def apply(self, h_walls: np.ndarray, v_walls: np.ndarray) -> None:
         model = self._model
         present = np.concatenate([h_walls.ravel(), v_walls.ravel()])
-        if present.shape != (len(self._segments),):
-            raise ValueError(f"wall arrays do not fit this arena ({len(self._segments)} segments)")
+        if present.shape != self._box_ids.shape:
+            raise ValueError(f"wall arrays do not fit this arena ({len(self._box_ids)} segments)")
         # Collision boxes: only the present ones collide.
         ids = self._box_ids
         model.geom_contype[ids] = present

@@ -42,6 +42,7 @@ from gymnasium.vector import AutoresetMode
 import mujoco_warp as mjw
 import warp as wp
 from mjmaze import batch, core, doom, look, mjcf, physics, rules, suite, walls
+from mjmaze.arena import Arena, ArenaIds
 
 # Where a geom that must not be seen or touched in a world goes (below the floor).
 _AWAY_Z = -50.0
@@ -51,37 +52,26 @@ _AWAY_Z = -50.0
 _CONTACTS_PER_WORLD = 32
 
 
-def build_model(task: core.MazeRules, view: look.View) -> tuple[mujoco.MjModel, np.ndarray, np.ndarray]:
-    """The task's arena as one MuJoCo model for all worlds, with a wall mesh per layout (:func:`mjmaze.mjcf.build_xml`).
+def build_model(task: core.MazeRules, view: look.View) -> tuple[mujoco.MjModel, ArenaIds, np.ndarray, np.ndarray]:
+    """The task's arena as one MuJoCo model for all worlds, with a wall mesh per layout (:class:`mjmaze.arena.Arena`).
 
-    Returns ``(model, mesh_of_config (C,), box_z_of_config (C, boxes))``: which
-    mesh draws configuration ``c``'s walls and where its wall boxes stand (an
-    absent wall's box below the floor).
+    Returns ``(model, ids, mesh_of_config (C,), box_z_of_config (C, boxes))``:
+    the model's parts, which mesh draws configuration ``c``'s walls and where
+    its wall boxes stand (an absent wall's box below the floor).
     """
-    layout = task.layout
     # One mesh per distinct wall layout among the task's configurations.
     all_configs = [task.configs[i] for i in range(len(task.configs))]
     layouts: dict[bytes, int] = {}
-    mesh_of_config = np.array([layouts.setdefault(c.layout_key(), len(layouts)) for c in all_configs], dtype=np.int32)
+    layout_of_config = [layouts.setdefault(c.layout_key(), len(layouts)) for c in all_configs]
     first_of_layout: dict[int, object] = {}
-    for config, mesh in zip(all_configs, mesh_of_config):
-        first_of_layout.setdefault(int(mesh), config)
-    quads = [walls.wall_mesh_quads(c.h_walls, c.v_walls, layout.cell_size) for c in first_of_layout.values()]
-    xml = mjcf.build_xml(layout.grid_size, layout.cell_size, task.objects, view.visual_style, task.room,
-                         wall_layout_quads=quads, width=view.width)
-    model = mujoco.MjModel.from_xml_string(xml)
-    mjcf.paint_textures(model, task.room, task.objects, view.width, layout.cell_size)
-    mjcf.set_ego_projection(model, view.width, view.height)
-    for mesh, config in first_of_layout.items():
-        mesh_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MESH, f"{walls.WALL_MESH}_{mesh}")
-        walls.write_wall_mesh(model, mesh_id, config.h_walls, config.v_walls, layout.cell_size)
-    visual = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "walls_visual")
-    model.geom_pos[visual] = 0.0  # mesh vertices are in world coordinates
-    model.geom_quat[visual] = (1.0, 0.0, 0.0, 0.0)
-    # Boxes wall_0, wall_1, ... follow h_walls then v_walls (walls.wall_segments).
+    for config, layout in zip(all_configs, layout_of_config):
+        first_of_layout.setdefault(layout, config)
+    model, ids = Arena(task, view, layouts=list(first_of_layout.values())).compile()
+    mesh_of_config = ids.wall_meshes[layout_of_config].astype(np.int32)
+    # Boxes follow h_walls then v_walls (walls.wall_segments).
     present = np.array([np.concatenate([c.h_walls.ravel(), c.v_walls.ravel()]) for c in all_configs], dtype=bool)
     box_z = np.where(present, walls.WALL_HEIGHT / 2, _AWAY_Z).astype(np.float32)
-    return model, mesh_of_config, box_z
+    return model, ids, mesh_of_config, box_z
 
 
 class MazeBatchEnv(batch.BatchEnv):
@@ -150,7 +140,7 @@ class MazeBatchEnv(batch.BatchEnv):
         self.xp = rules.namespace(torch.zeros(1))
         height, width = view.height, view.width
 
-        mjm, mesh_of_config, box_z = build_model(task, view)
+        mjm, ids, mesh_of_config, box_z = build_model(task, view)
         self._host_model = mjm
         dev = self.device
         table = task.config_arrays([task.configs[i] for i in range(len(task.configs))])
@@ -160,25 +150,16 @@ class MazeBatchEnv(batch.BatchEnv):
         num_configs = len(task.configs)
         self._first = torch.tensor(batch.first_configs(first, n, num_configs), device=dev)
 
-        def geom(name: str) -> int:
-            return mujoco.mj_name2id(mjm, mujoco.mjtObj.mjOBJ_GEOM, name)
-
-        first_box = geom("wall_0")
-        self._box_ids = torch.arange(first_box, first_box + box_z.shape[1], device=dev)
-        self._wall_visual = geom("walls_visual")
-        self._object_ids = torch.tensor([geom(obj.name) for obj in task.objects], dtype=torch.long, device=dev)
+        self._box_ids = torch.as_tensor(ids.wall_boxes, device=dev)
+        self._wall_visual = ids.wall_visual
+        self._object_ids = torch.as_tensor(ids.objects, dtype=torch.long, device=dev)
         self._object_z = torch.tensor([obj.z for obj in task.objects], dtype=torch.float32, device=dev)
         # What Doom draws beyond the scene, for every world at once: the CPU envs' pipeline.
-        self._pipeline = look.FramePipeline(self.xp, dev, view, task, mjm)
-        self._sprites = self._pipeline.sprites
-        self._sprite_ids = torch.as_tensor(self._sprites.geom_ids if self._sprites else [], dtype=torch.long, device=dev)
-        self._sprite_objects = torch.as_tensor(self._sprites.object_index if self._sprites else [], dtype=torch.long,
-                                               device=dev)
-        colliding = [k for k, obj in enumerate(task.objects) if obj.collides]
-        self._colliding = torch.tensor(colliding, dtype=torch.long, device=dev)
-        self._collision_ids = torch.tensor(
-            [geom(task.objects[k].name + mjcf.COLLISION_SUFFIX) for k in colliding], dtype=torch.long, device=dev
-        )
+        self._pipeline = look.FramePipeline(self.xp, dev, view, task, mjm, ids)
+        self._sprite_ids = torch.as_tensor(ids.sprites, dtype=torch.long, device=dev)
+        colliding = np.flatnonzero(ids.collision >= 0)
+        self._colliding = torch.as_tensor(colliding, dtype=torch.long, device=dev)
+        self._collision_ids = torch.as_tensor(ids.collision[colliding], dtype=torch.long, device=dev)
         self._timestep = float(mjm.opt.timestep)
         self._actions = torch.tensor(task.actions, dtype=torch.float64, device=dev)  # (A, 2): forward, turn
 
@@ -205,7 +186,7 @@ class MazeBatchEnv(batch.BatchEnv):
         self._geom_matid = wp.to_torch(self._model.geom_matid)  # per world with sprites
         self._geom_dataid = wp.to_torch(self._model.geom_dataid)
         self._cam_pos = wp.to_torch(self._model.cam_pos)  # per world with head-bob
-        self._camera = mujoco.mj_name2id(mjm, mujoco.mjtObj.mjOBJ_CAMERA, mjcf.EGO_CAMERA)
+        self._camera = ids.ego_camera
         self._rgb_packed = wp.to_torch(self._render.rgb_data)
         self._depth = wp.to_torch(self._render.depth_data).view(n, height, width) if textured else None
         self._cam_xpos = wp.to_torch(self._data.cam_xpos)

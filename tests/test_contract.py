@@ -1,5 +1,6 @@
 """One contract over every registered scenario (as dm_control's suite_test), and a fifth scenario
-defined here: registering it is all it takes for load, gymnasium, the vector env and check_env.
+defined here: registering it is all it takes for load, gymnasium, the vector env (its workers are
+separate processes: the scenario reaches them with the env) and check_env.
 """
 
 from __future__ import annotations
@@ -66,28 +67,6 @@ def test_a_fifth_scenario_loads_and_plays():
     env.physics.set_agent_pose(x - 0.2, y, 0.0)
     timestep = env.step(0)
     assert timestep.last() and timestep.reward == 1.0 and timestep.discount == 0.0
-
-
-def test_a_fifth_scenario_through_gymnasium_and_check_env():
-    env = gymnasium.make("mjmaze_test/Beacon-v0", size=4, render_mode="rgb_array")
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        check_env(env.unwrapped, skip_render_check=False)
-    env.close()
-
-
-@pytest.mark.slow
-def test_a_fifth_scenario_in_the_vector_env():
-    # Its workers are separate processes: the scenario reaches them with the env.
-    envs = gymnasium.make_vec("mjmaze_test/Beacon-v0", num_envs=4, vectorization_mode="vector_entry_point", num_workers=2)
-    try:
-        obs, info = envs.reset(seed=0)
-        assert obs.shape == (4, 64, 112, 3) and "reached" in info
-        for _ in range(5):
-            obs, reward, terminated, truncated, info = envs.step(envs.action_space.sample())
-        assert obs.shape == (4, 64, 112, 3)
-    finally:
-        envs.close()
 
 
 def test_a_fifth_scenario_gets_its_own_configurations_and_flags():
@@ -229,8 +208,46 @@ def test_gymnasium_spaces_info_and_render(name):
     assert env.observation_space == gymnasium.spaces.Box(0, 255, (64, 112, 3), np.uint8)
     obs, info = env.reset(seed=1)
     expected = set(env.unwrapped.task.rules.info_fields())
-    assert set(info) == expected and registry.get(name).metric in info
-    obs, reward, terminated, truncated, info = env.step(2)
-    assert set(info) == expected and isinstance(reward, float)
+    assert registry.get(name).metric in expected
+    assert expected >= {"x", "y", "yaw", "step", "episode_return", "config_index"}
+    assert set(info) == expected
+    for action in np.random.default_rng(0).integers(5, size=50):  # every step's info has every field
+        obs, reward, terminated, truncated, info = env.step(int(action))
+        assert set(info) == expected and isinstance(reward, float)
+        if terminated or truncated:
+            env.reset()
     assert np.array_equal(env.render(), obs)
     env.close()
+
+
+@pytest.mark.slow
+def test_check_env_passes_without_warnings(name):
+    env = gymnasium.make(registry.get(name).gym_id, split="train", render_mode="rgb_array")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(env.unwrapped, skip_render_check=False)
+    env.close()
+
+
+@pytest.mark.slow
+def test_a_vector_env_plays_each_env_as_one_env_seeded_alike(name):
+    # Env i of a vector env seeded s is the env gymnasium.make gives, reset with seed s + i: the same
+    # frames, rewards, flags and infos, whichever process steps it.
+    gym_id = registry.get(name).gym_id
+    envs = gymnasium.make_vec(gym_id, num_envs=2, vectorization_mode="vector_entry_point", num_workers=1)
+    single = gymnasium.make(gym_id)
+    try:
+        batch_obs, batch_info = envs.reset(seed=3)
+        obs, info = single.reset(seed=3)
+        assert np.array_equal(batch_obs[0], obs) and {k: batch_info[k][0] for k in info} == info
+        for actions in np.random.default_rng(2).integers(5, size=(40, 2)):
+            batch_obs, rewards, terminated, truncated, batch_info = envs.step(actions)
+            obs, reward, ended, cut, info = single.step(int(actions[0]))
+            assert np.array_equal(batch_obs[0], obs) and rewards[0] == reward
+            assert (terminated[0], truncated[0]) == (ended, cut)
+            assert {k: batch_info[k][0] for k in info} == info
+            if ended or cut:  # the vector env restarts it on its next step, as gymnasium's own
+                break
+    finally:
+        envs.close()
+        single.close()

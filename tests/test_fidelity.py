@@ -70,7 +70,7 @@ def test_a_wall_is_darker_far_away_than_near():
 def test_views_ninety_degrees_apart_differ_at_a_symmetric_spot(style, distinct):
     # The centre of the empty arena, totem hidden: four views the flat look draws alike.
     env = load("two_colour", complexity=0, item_cap=0, visual_style=style)
-    env.physics.show_objects(env.physics.object_ids([two_colour.TOTEM.name])[1], False)
+    env.physics.show_objects(env.physics.object_ids([two_colour.TOTEM.name]), False)
     frames = []
     for yaw in (0.0, math.pi / 2, math.pi, -math.pi / 2):
         place(env, 0.0, 0.0, yaw)
@@ -124,7 +124,7 @@ def flat_views(task, centre, extent=1.0, pixels=128):
                       projection="orthographic", fovy=str(extent))
     root.find("visual/global").attrib.update(offwidth=str(pixels), offheight=str(pixels))
     model = mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
-    mjcf.paint_textures(model, task.rules.room, (), task.view.width, task.rules.layout.cell_size)
+    mjcf.paint_textures(model, task.rules.room, task.rules.layout.cell_size)
     # Whiter, so GL draws the texels themselves rather than a few dim grey levels
     # (GL's colour: the material's times its emission plus the ambient light).
     for name in ("floor", "ceiling"):
@@ -196,7 +196,7 @@ def test_a_two_colour_item_passed_mid_step_is_picked_up():
     task = env.task
     task.state["object_xy"][0, 1:][:] = (4.5, 4.5)  # every item out of the way but one
     task.state["object_xy"][0, 1:][0] = (-2.0, -3.0)
-    env.physics.place_objects(env.physics.object_ids([item.name for item in two_colour.ITEMS])[0], task.state["object_xy"][0, 1:])
+    env.physics.place_objects(env.physics.object_ids([item.name for item in two_colour.ITEMS]), task.state["object_xy"][0, 1:])
     beside(env, task.state["object_xy"][0, 1:][0])
     env.step(FORWARD)
     assert not task.state["object_shown"][0, 1:][0]
@@ -385,7 +385,7 @@ def test_a_released_spawn_on_the_totem_spot_has_no_totem_as_in_vizdoom(tmp_path)
     x, y, yaw = env.physics.agent_pose()
     assert (x, y, yaw) == (0.0, 0.0, 0.0)  # on the totem's spot, facing +x
     place(env, 1.0, 0.0, math.pi)  # 1 m off, facing the spot: nothing there to see
-    totem = env.physics.object_ids([two_colour.TOTEM.name])[1]
+    totem = env.physics.object_ids([two_colour.TOTEM.name])
     assert not np.isin(env.task.segmentation(env.physics), totem).any()
     path = push(env, FORWARD, 8)  # nor to bump into: the agent walks over the spot
     assert np.hypot(*path.T).min() < 0.05

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from mjmaze import doom, look, mjcf, suite
-from mjmaze.tasks import base, two_colour
+from mjmaze.tasks import base
 
 # Actions as ViZDoom played them: forward 12 steps, nothing 8, forward 15, nothing 10.
 HELD = [1] * 12 + [0] * 8 + [1] * 15 + [0] * 10

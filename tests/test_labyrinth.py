@@ -176,7 +176,7 @@ def test_the_exit_is_a_small_item_on_the_floor_as_released():
             break
         env.task.close()
     ex, ey = config.cell_centre(config.object_cells[0])
-    (exit_geom,) = env.physics.object_ids(["exit"])[1]
+    (exit_geom,) = env.physics.object_ids(["exit"])
 
     def exit_pixels(distance, yaw=0.0):
         place(env, ex - distance, ey, yaw)

@@ -36,7 +36,7 @@ def empty_room(room: palette.Room, first_item: mjcf.ObjectGeom | None = None):
         task.rules.objects = (two_colour.TOTEM, first_item, *two_colour.ITEMS[1:])
     env = base.make_environment(task)
     env.reset()
-    env.physics.show_objects(env.physics.object_ids([o.name for o in task.rules.objects])[1], False)
+    env.physics.show_objects(env.physics.object_ids([o.name for o in task.rules.objects]), False)
     return env
 
 
@@ -134,7 +134,7 @@ def test_two_colour_walls_are_the_released_grey_stone2():
     # GSTONE1: a Two-colour wall is as grey as Labyrinth's (ViZDoom: 38 grey 1 m ahead).
     env = mjmaze.load("two_colour", task_kwargs={"complexity": 0, "random": 0})
     env.reset()
-    env.physics.show_objects(env.physics.object_ids([o.name for o in env.task.rules.objects])[1], False)
+    env.physics.show_objects(env.physics.object_ids([o.name for o in env.task.rules.objects]), False)
     red, green, blue = wall_colour(env, 1.0)
     env.task.close()
     assert (red, green, blue) == pytest.approx((38, 38, 38), abs=CLOSE)
@@ -162,7 +162,7 @@ def object_colour(env, name, pose, animation_steps=1, first_step=0):
     for step in range(first_step, first_step + animation_steps):
         task.state["steps"][row] = step
         frame = frame_at(env, *pose)
-        mask = np.isin(task.segmentation(env.physics), env.physics.object_ids([name])[1])
+        mask = np.isin(task.segmentation(env.physics), env.physics.object_ids([name]))
         rows, cols, _ = look.pistol_pixels(frame.shape[1], frame.shape[0])
         mask[rows, cols] = False
         assert mask.sum() >= 10
@@ -189,14 +189,14 @@ ITEMS_1M_AHEAD = {
 def stone_room_with(sprite):
     """The empty STONE2 room whose first item is ``sprite`` (a K-item kind), shown."""
     env = empty_room(palette.STONE_ROOM, mjcf.sprite_thing("item_0", sprite))
-    env.physics.show_objects(env.physics.object_ids(["item_0"])[1], True)
+    env.physics.show_objects(env.physics.object_ids(["item_0"]), True)
     return env
 
 
 @pytest.mark.parametrize("sprite", list(ITEMS_1M_AHEAD), ids=lambda sprite: sprite.name)
 def test_each_item_is_freedoom_0_10_1s_picture_as_bright_as_vizdoom_draws_it(sprite):
     env = stone_room_with(sprite)
-    env.physics.place_objects(env.physics.object_ids(["item_0"])[0], np.array([[1.0, 0.3]]))
+    env.physics.place_objects(env.physics.object_ids(["item_0"]), np.array([[1.0, 0.3]]))
     colour = object_colour(env, "item_0", (0.0, 0.0, 0.0), animation_steps=45)  # every kind's whole cycle
     env.task.close()
     doom = np.array(ITEMS_1M_AHEAD[sprite])
@@ -215,11 +215,11 @@ def test_a_sprite_faces_the_camera_from_every_side(heading):
     physics = env.physics
     ids = physics.object_ids(["item_0"])
     item = np.array([0.5, 0.5])
-    physics.place_objects(ids[0], item[None])
+    physics.place_objects(ids, item[None])
     x, y = item - 1.2 * np.array([np.cos(heading), np.sin(heading)])
     place(env, x, y, heading)
     frame = env.task.get_observation(physics)["pixels"].astype(float)
-    mask = np.isin(env.task.segmentation(physics), ids[1])
+    mask = np.isin(env.task.segmentation(physics), ids)
     env.task.close()
     assert 25 <= mask.sum() <= 40, mask.sum()  # 32 from every side
     pixels = frame[mask]
@@ -234,7 +234,7 @@ def test_the_armour_blinks_as_dooms_a_sector_lit_picture_then_a_fullbright_one()
     # tics, so steps 0..12 show every tic of the cycle once (this item's blink
     # starts at tic 0, as the Two-colour script's first items).
     env = stone_room_with(sprites.GREEN_ARMOUR)
-    env.physics.place_objects(env.physics.object_ids(["item_0"])[0], np.array([[1.0, 0.3]]))
+    env.physics.place_objects(env.physics.object_ids(["item_0"]), np.array([[1.0, 0.3]]))
     brightness = np.array([object_colour_at_step(env, step).sum() for step in range(13)])
     env.task.close()
     tics = (FIRST_OBSERVATION_TIC + 4 * np.arange(13)) % 13
@@ -257,7 +257,7 @@ def test_two_colours_red_item_is_bright_at_one_observation_in_three_as_in_vizdoo
     # 9, ...: the sector-lit picture, the sector-lit one, then the fullbright one
     # (measured on the released Two-colour 5 mazes: bright at 35% of sightings).
     env = stone_room_with(sprites.BLUE_ARMOUR)
-    env.physics.place_objects(env.physics.object_ids(["item_0"])[0], np.array([[1.0, 0.3]]))
+    env.physics.place_objects(env.physics.object_ids(["item_0"]), np.array([[1.0, 0.3]]))
     brightness = np.array([object_colour_at_step(env, step).sum() for step in range(12)])
     env.task.close()
     bright = brightness > brightness.mean()
@@ -294,10 +294,10 @@ def test_a_sprite_shows_its_picture_averaged_as_the_released_resize_averages_it(
     env = stone_room_with(sprites.MEDIKIT)
     physics = env.physics
     ids = physics.object_ids(["item_0"])
-    physics.place_objects(ids[0], np.array([[distance, 0.3 * distance]]))
+    physics.place_objects(ids, np.array([[distance, 0.3 * distance]]))
     frame = frame_at(env, 0.0, 0.0, 0.0)
-    drawn = frame[env.task.segmentation(physics) == ids[1][0]]
-    material = physics.model.id2name(physics.model.geom_matid[ids[1][0]], "material")
+    drawn = frame[env.task.segmentation(physics) == ids[0]]
+    material = physics.model.id2name(physics.model.geom_matid[ids[0]], "material")
     env.task.close()
     bins = sprites.depth_bins(mjcf.unit_depth(112))
     depth_bin = int(np.searchsorted(bins.edges, distance))
@@ -323,7 +323,7 @@ def test_a_fullbright_picture_is_drawn_in_its_own_colours_at_any_depth(distance)
     # mean is (96, 59, 59)). mjmaze's light on things falls with depth, so the
     # picture is drawn brighter the deeper its bin.
     env = stone_room_with(sprites.SOULSPHERE)
-    env.physics.place_objects(env.physics.object_ids(["item_0"])[0], np.array([[distance, 0.0]]))
+    env.physics.place_objects(env.physics.object_ids(["item_0"]), np.array([[distance, 0.0]]))
     colour = object_colour(env, "item_0", (0.0, 0.0, 0.0))
     env.task.close()
     rgb, opaque, _ = sprites.picture("SOULB0")  # step 0 is level tic 10: frame B
@@ -337,10 +337,10 @@ def test_a_sector_lit_picture_darkens_through_doom_s_colormaps():
     # would gives (50, 27, 28) (0.54), as mjmaze drew it before.
     env = stone_room_with(sprites.BLUE_ARMOUR)
     ids = env.physics.object_ids(["item_0"])
-    env.physics.place_objects(ids[0], np.array([[4.0, 0.0]]))
+    env.physics.place_objects(ids, np.array([[4.0, 0.0]]))
     env.task.state["steps"][0] = 1  # level tic 14: frame A (sector-lit)
     frame = frame_at(env, 0.0, 0.0, 0.0)
-    colour = frame[env.task.segmentation(env.physics) == ids[1][0]].astype(float).mean(axis=0)
+    colour = frame[env.task.segmentation(env.physics) == ids[0]].astype(float).mean(axis=0)
     env.task.close()
     assert colour[1] / colour[0] > 0.7 and colour[0] == pytest.approx(38, abs=8), colour
 
@@ -352,9 +352,9 @@ def test_an_item_s_picture_shows_whole_above_the_floor():
     env = stone_room_with(sprites.BLUE_ARMOUR)
     physics = env.physics
     ids = physics.object_ids(["item_0"])
-    physics.place_objects(ids[0], np.array([[0.6, 0.15]]))
+    physics.place_objects(ids, np.array([[0.6, 0.15]]))
     frame_at(env, 0.0, 0.0, 0.0)
-    rows = np.flatnonzero((env.task.segmentation(physics) == ids[1][0]).any(axis=1))
+    rows = np.flatnonzero((env.task.segmentation(physics) == ids[0]).any(axis=1))
     env.task.close()
     assert rows.max() - rows.min() + 1 >= 14
 
@@ -363,12 +363,12 @@ def test_two_colour_items_are_the_green_and_the_red_armour_alternately():
     env = empty_room(palette.SLIME_ROOM)
     physics = env.physics
     ids = physics.object_ids(["item_0", "item_1"])
-    physics.show_objects(ids[1], True)
-    physics.place_objects(ids[0], np.array([[1.0, 0.3], [1.0, -0.3]]))
+    physics.show_objects(ids, True)
+    physics.place_objects(ids, np.array([[1.0, 0.3], [1.0, -0.3]]))
     frame = frame_at(env, 0.0, 0.0, 0.0)
     seg = env.task.segmentation(physics)
     env.task.close()
-    green_item, red_item = (frame[seg == geom] for geom in ids[1])
+    green_item, red_item = (frame[seg == geom] for geom in ids)
     assert np.mean(green_item[:, 1] > 1.3 * green_item[:, 0]) > 0.1  # the green armour's pads
     assert np.mean(green_item[:, 0] > 1.5 * green_item[:, 1]) < 0.2
     assert np.mean(red_item[:, 0] > 1.5 * red_item[:, 1]) > 0.3  # the red vest
@@ -391,7 +391,7 @@ def test_maps_and_the_flat_style_show_a_sprite_in_its_mean_colour(scenario):
     model = env.physics.model
     for obj in env.task.rules.objects:
         if obj.sprite is not None:  # a cylinder in the picture's mean colour, no texture
-            geom = env.physics.object_ids([obj.name])[1][0]
+            geom = env.physics.object_ids([obj.name])[0]
             assert model.geom_type[geom] == mujoco.mjtGeom.mjGEOM_CYLINDER
             assert tuple(model.geom_rgba[geom]) == pytest.approx((*sprites.mean_colour(obj.sprite), 1.0))
     env.task.close()
@@ -399,7 +399,7 @@ def test_maps_and_the_flat_style_show_a_sprite_in_its_mean_colour(scenario):
     env.reset()
     top_down = viz.TopDown(env, size=128)
     image = top_down.render()
-    shown = [obj for obj, geom in zip(env.task.rules.objects, env.physics.object_ids([o.name for o in env.task.rules.objects])[1])
+    shown = [obj for obj, geom in zip(env.task.rules.objects, env.physics.object_ids([o.name for o in env.task.rules.objects]))
              if obj.sprite is not None and env.physics.model.geom_group[geom] != render.HIDDEN_GROUP]
     assert shown
     for obj in shown:  # lying on the floor, face up, in its mean colour
@@ -440,9 +440,9 @@ def object_ahead(name, rgba, distance=2.0):
     env = empty_room(palette.SLIME_ROOM)
     physics = env.physics
     ids = physics.object_ids([name])
-    physics.set_object_rgba(ids[1][0], rgba)
-    physics.show_objects(ids[1], True)
-    physics.place_objects(ids[0], np.array([[distance, 0.0]]))
+    physics.set_object_rgba(ids[0], rgba)
+    physics.show_objects(ids, True)
+    physics.place_objects(ids, np.array([[distance, 0.0]]))
     colour = object_colour(env, name, (0.0, 0.0, 0.0))
     env.task.close()
     return colour
@@ -461,12 +461,12 @@ def test_the_pistol_when_asked_for_hides_a_floor_item_right_ahead():
     env.reset()
     physics = env.physics
     exit_ids = physics.object_ids([labyrinth.EXIT.name])
-    physics.place_objects(exit_ids[0], np.array([[0.6, 0.0]]))
+    physics.place_objects(exit_ids, np.array([[0.6, 0.0]]))
     frame = frame_at(env, 0.0, 0.0, 0.0)
     seg = env.task.segmentation(physics)
     rows, cols, rgb = look.pistol_pixels(frame.shape[1], frame.shape[0])
     assert (frame[rows, cols] == rgb).all()  # drawn over the view
-    hidden = np.isin(seg[rows, cols], exit_ids[1]).sum()
+    hidden = np.isin(seg[rows, cols], exit_ids).sum()
     assert hidden >= 10  # the exit is there, behind the pistol
     env.task.close()
 
@@ -498,7 +498,7 @@ def test_a_sprite_out_of_view_is_left_out_of_the_render_and_the_frame_is_the_sam
     # segmentation render the same model).
     env = stone_room_with(sprites.GREEN_ARMOUR)
     physics, task = env.physics, env.task
-    geom = physics.object_ids(["item_0"])[1][0]
+    geom = physics.object_ids(["item_0"])[0]
     physics.place_objects(geom, np.array([[0.5, 0.5]]))
     place(env, 1.5, 0.5, math.pi if ahead else 0.0)  # the item 1 m ahead, or 1 m behind
     left_out = []

@@ -104,7 +104,7 @@ def test_all_items_in_order_pay_once_each_and_end_the_episode(num_items):
 def test_a_collected_item_disappears_and_cannot_be_collected_again():
     env = load("k_item", num_items=2)
     first = item_positions(env)[0]
-    _, geom = env.physics.object_ids([k_item.KINDS[0][1].name])
+    geom = env.physics.object_ids([k_item.KINDS[0][1].name])
 
     def drawn_from_half_a_metre():
         place(env, first[0] - 0.5, first[1], 0.0)
@@ -130,7 +130,7 @@ def test_item_colours_come_out_distinct_in_rendered_pixels():
     for kind, xy in enumerate(item_positions(env)):
         place(env, xy[0] - 0.6, xy[1] - 0.25, 0.0)  # off centre: the pistol hides what is right ahead
         shown = env.task.get_observation(env.physics)["pixels"].astype(float)
-        _, geom = env.physics.object_ids([k_item.KINDS[kind][1].name])
+        geom = env.physics.object_ids([k_item.KINDS[kind][1].name])
         env.physics.show_objects(geom, False)
         hidden = env.task.get_observation(env.physics)["pixels"].astype(float)
         env.physics.show_objects(geom, True)
@@ -159,7 +159,7 @@ def test_totem_colour_is_drawn_per_episode_and_shown():
         env.reset()
         colours.append(bool(env.task.state["totem_green"][0]))
     assert 10 < sum(colours) < 30
-    _, (totem,) = env.physics.object_ids([two_colour.TOTEM.name])
+    (totem,) = env.physics.object_ids([two_colour.TOTEM.name])
     totem_rgba = env.physics.model.geom_rgba[totem]
     assert tuple(totem_rgba) == pytest.approx(two_colour.GREEN if colours[-1] else two_colour.RED)
 
@@ -312,7 +312,7 @@ def test_items_do_not_block_movement():
     env = load("two_colour", complexity=0)
     task = env.task
     task.state["object_xy"][0, 1:][0] = (-0.8, 0.5)
-    (item,), _ = env.physics.object_ids([two_colour.ITEMS[0].name])
+    (item,) = env.physics.object_ids([two_colour.ITEMS[0].name])
     env.physics.place_objects(item, task.state["object_xy"][0, 1:][0])
     place(env, -1.4, 0.5, 0.0)
     for _ in range(6):  # about 1 m from rest

@@ -140,20 +140,6 @@ def test_each_env_gets_its_own_seed():
     envs.close()
 
 
-@pytest.mark.parametrize(
-    "scenario, kwargs",
-    [("find_return", {"size": 5}), ("k_item", {"num_items": 4}), ("two_colour", {"complexity": 3})],
-)
-@pytest.mark.slow
-def test_every_scenario_runs(scenario, kwargs):
-    envs = MazeVectorEnv(2, scenario, **kwargs)
-    envs.reset(seed=0)
-    for _ in range(5):
-        obs, rewards, *_ = envs.step(np.array([2, 3]))
-    assert obs.std() > 0 and np.isfinite(rewards).all()
-    envs.close()
-
-
 @pytest.mark.slow
 def test_a_killed_worker_is_a_clear_error_not_a_hang():
     envs = MazeVectorEnv(4, "labyrinth", size=5, num_workers=2)

@@ -198,7 +198,7 @@ def mjmaze_view(env, spawn: tuple[float, float, int], objects: list[str]) -> tup
     task, physics = env.task, env.physics
     physics.set_agent_pose(spawn[0] / UNITS, spawn[1] / UNITS, math.radians(spawn[2]))
     physics.forward()
-    geoms = physics.object_ids(objects)[1]
+    geoms = physics.object_ids(objects)
     mask = np.isin(task.segmentation(physics), geoms).astype(np.float64)
     rows, cols, _ = look.pistol_pixels(*SIZE)
     mask[rows, cols] = 0.0  # what the pistol hides
@@ -276,7 +276,7 @@ def empty_arena(room: str, pistol: bool = True):
     task.rules.pistol = pistol  # as the ViZDoom probe beside it (released_game's weapon)
     env = base.make_environment(task)
     env.reset()
-    env.physics.show_objects(env.physics.object_ids([o.name for o in task.rules.objects])[1], False)
+    env.physics.show_objects(env.physics.object_ids([o.name for o in task.rules.objects]), False)
     return env
 
 
@@ -314,7 +314,7 @@ def calibrate() -> None:
     for label, scenario, kwargs, cell_of, things_of, name, hidden in cases:
         env, config, poses = scenario_maze(scenario, kwargs, cell_of)
         if hidden:  # only the measured object in view
-            env.physics.show_objects(env.physics.object_ids(hidden)[1], False)
+            env.physics.show_objects(env.physics.object_ids(hidden), False)
         results = []
         for distance in sorted(poses)[:3]:
             row, col, angle = poses[distance]
@@ -336,11 +336,11 @@ def calibrate() -> None:
     ):
         ids = physics.object_ids([name])
         if rgba is not None:  # the totem's colour is the episode's
-            physics.set_object_rgba(ids[1][0], rgba)
-        physics.show_objects(ids[1], True)
+            physics.set_object_rgba(ids[0], rgba)
+        physics.show_objects(ids, True)
         results = []
         for d in (1, 2, 3):
-            physics.place_objects(ids[0], np.array([[d, 0.0]]))
+            physics.place_objects(ids, np.array([[d, 0.0]]))
             doom, doom_mask = doom_view(textmap(config, (0.0, 0.0, 0), [Thing(d * UNITS, 0.0, doom_type)], SLIME),
                                         weapon=False)
             ours, our_mask = mjmaze_view(env, (0.0, 0.0, 0), [name])
@@ -493,7 +493,7 @@ def armour_parts() -> None:
             ("red armour, red part", BLUE_ARMOUR, 0, 30, two_colour.ITEMS[1])):
         name = item.name
         ids = physics.object_ids([name])
-        physics.show_objects(ids[1], True)
+        physics.show_objects(ids, True)
         results = []
         for d in (1, 2, 3, 4):
             screens, drawn = doom_tics(textmap(config, (0.0, 0.0, 0), [Thing(d * UNITS, 0.0, doom_type)], SLIME),
@@ -541,12 +541,12 @@ def item_contrast() -> None:
     for label, doom_type, item in (("green item (green armour)", GREEN_ARMOUR, two_colour.ITEMS[0]),
                                    ("red item (Freedoom's blue armour)", BLUE_ARMOUR, two_colour.ITEMS[1])):
         ids = physics.object_ids([item.name])
-        physics.show_objects(ids[1], True)
+        physics.show_objects(ids, True)
         total = np.zeros((2, 2))  # (Doom, mjmaze) x (sector-lit, fullbright)
         for d in np.arange(0.8, 4.05, 0.1):
             frames, _ = doom_tics(textmap(config, (0.0, 0.0, 0), [Thing(d * UNITS, 0.0, doom_type)], SLIME),
                                   weapon=False)
-            physics.place_objects(ids[0], np.array([[d, 0.0]]))
+            physics.place_objects(ids, np.array([[d, 0.0]]))
             for engine, (seen, empty) in enumerate(((frames, empty_doom), (mjmaze_steps(env), empty_ours))):
                 mass = np.abs(seen.astype(np.float64) - empty.astype(np.float64)).sum(axis=(1, 2, 3)) / 255
                 bright = mass > (mass.min() + mass.max()) / 2

@@ -99,7 +99,7 @@ def wall_slide(angles=(20, 45, 70), steps: int = 12) -> None:
                              game.get_game_variable(vzd.GameVariable.POSITION_Y)))
             game.close()
         env.reset()
-        physics.show_objects(physics.object_ids([o.name for o in env.task.rules.objects])[1], False)
+        physics.show_objects(physics.object_ids([o.name for o in env.task.rules.objects]), False)
         physics.set_agent_pose(x0 * doom.MAP_UNIT, y0 * doom.MAP_UNIT, math.radians(heading))
         ours = []
         for _ in range(steps):

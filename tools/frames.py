@@ -28,7 +28,7 @@ def best_view(name: str, task_kwargs: dict) -> np.ndarray:
     env.reset()
     task, physics = env.task, env.physics
     config = task.config
-    object_geoms = physics.object_ids([geom.name for geom in task.rules.objects])[1]
+    object_geoms = physics.object_ids([geom.name for geom in task.rules.objects])
     best, best_score = None, -1
     for row in range(config.size):
         for col in range(config.size):

@@ -52,6 +52,7 @@ import torch
 
 from mjmaze import files, rules, sprites, suite
 from mjmaze.doom import FIRST_OBSERVATION_TIC, MAP_UNIT, TICS_PER_STEP
+from mjmaze.tasks import two_colour
 from mjmaze.train import paper_agents
 
 LIMITED_ACTIONS = ([True, False, False, False], [False, True, False, False], [False, False, True, False],
@@ -675,7 +676,7 @@ def blink(name: str, checkout: str, mazes: int = 8, steps: int = 300, wad: str |
     for doom, sprite in kinds.items():
         for k, obj in enumerate(task.rules.objects):
             if obj.sprite is sprite:
-                by_geom[int(physics.object_ids([obj.name])[1][0])] = (doom, k)
+                by_geom[int(physics.object_ids([obj.name])[0])] = (doom, k)
     for _ in range(mazes):
         timestep = env.reset()
         for _ in range(steps):
@@ -728,7 +729,6 @@ def _place_two_colour_things(task, physics, things: tuple[list, bool | None], fl
                              hide: bool, starts: dict | None = None) -> None:
     """Sets mjmaze's Two-colour episode to ViZDoom's things and flash counters (items of a colour fill its slots in
     turn); ``starts``: each ViZDoom item's (by object id) animation start, its spawn tic."""
-    from mjmaze.tasks import two_colour
 
     items, totem_green = things
     state, row = task.state, 0  # a dm_control env: a batch of one

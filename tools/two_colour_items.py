@@ -18,7 +18,7 @@ import numpy as np
 import torch
 
 import mjmaze
-from mjmaze.tasks import base
+from mjmaze.tasks import base, two_colour
 from mjmaze.train import policy
 
 

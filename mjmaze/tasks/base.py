@@ -19,6 +19,7 @@ from dm_control.suite import base
 from dm_env import specs
 
 from mjmaze import configs, core, doom, look, mjcf
+from mjmaze.arena import Arena
 from mjmaze.rules import seed_key
 from mjmaze.group import EnvGroup
 # The timing, motion and action names scenario code and tests read as base.*.
@@ -167,15 +168,13 @@ class MazeTask(base.Task):
 
 
 def make_physics(rules: core.MazeRules, view: look.View, count: int = 1) -> list[MazePhysics]:
-    """``count`` physics of the scenario's arena (its model built once, compiled for each), the camera's
-    projection final."""
-    xml = mjcf.build_xml(rules.layout.grid_size, rules.layout.cell_size, rules.objects, view.visual_style,
-                         rules.room, width=view.width)
+    """``count`` physics of the scenario's arena (:class:`mjmaze.arena.Arena`: its MJCF written once, compiled
+    for each), final, each knowing its parts' ids (``physics.arena``)."""
+    arena = Arena(rules, view)
     made = []
     for _ in range(count):
-        physics = MazePhysics.from_xml_string(xml)
-        mjcf.paint_textures(physics.model.ptr, rules.room, rules.objects, view.width, rules.layout.cell_size)
-        mjcf.set_ego_projection(physics.model.ptr, view.width, view.height)
+        physics = MazePhysics.from_xml_string(arena.xml)
+        physics.arena = arena.finish(physics.model.ptr)
         made.append(physics)
     return made
 
