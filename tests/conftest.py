@@ -8,15 +8,21 @@ import numpy as np
 import pytest
 
 import mjmaze
-from mjmaze import maze
+from mjmaze import maze, registry, suite
+
+import fifth_scenario
+
+# Registered before any test module is collected: every test parametrised over the registry runs it.
+suite.register(fifth_scenario.SCENARIO)
 
 FORWARD, TURN_LEFT, TURN_RIGHT = 2, 0, 1
-# Each scenario at a small setting: for tests that run every scenario on torch or MuJoCo Warp (compile and step time).
+# Every registered scenario at a small setting, for tests that run every scenario on torch or MuJoCo
+# Warp (compile and step time): its smallest difficulty, but K-item with 4 items and Two-colour at
+# complexity 3, where there are more objects and walls to get wrong.
 SMALL_SETTINGS = {
-    "labyrinth": {"size": 5},
-    "find_return": {"size": 5},
-    "k_item": {"num_items": 4},
-    "two_colour": {"complexity": 3},
+    scenario.name: {"k_item": {"num_items": 4}, "two_colour": {"complexity": 3}}.get(
+        scenario.name, {scenario.difficulty: min(scenario.difficulties)})
+    for scenario in registry.all_scenarios()
 }
 
 
