@@ -7,7 +7,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from mjmaze import suite
+from mjmaze import core, physics, suite
 from mjmaze.tasks import base
 
 
@@ -23,7 +23,7 @@ class MazeEnv(gym.Env):
     same mazes, spawns and frames.
     """
 
-    metadata = {"render_modes": ["rgb_array"], "render_fps": base.STEPS_PER_SECOND}
+    metadata = {"render_modes": ["rgb_array"], "render_fps": core.STEPS_PER_SECOND}
 
     def __init__(self, scenario: str, render_mode: str | None = None, **task_kwargs: Any):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -31,7 +31,7 @@ class MazeEnv(gym.Env):
         self.render_mode = render_mode
         self._env = suite.load(scenario, task_kwargs)
         self.task: base.MazeTask = self._env.task
-        self.physics: base.MazePhysics = self._env.physics
+        self.physics: physics.MazePhysics = self._env.physics
         pixels = self._env.observation_spec()["pixels"]
         self.observation_space = gym.spaces.Box(0, 255, pixels.shape, np.uint8)
         self.action_space = gym.spaces.Discrete(self._env.action_spec().num_values)

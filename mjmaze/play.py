@@ -22,16 +22,15 @@ import time
 import numpy as np
 
 import mjmaze
-from mjmaze import files, suite, viz
-from mjmaze.tasks import base
+from mjmaze import core, files, suite, viz
 
-STEPS_PER_SECOND = base.STEPS_PER_SECOND
+STEPS_PER_SECOND = core.STEPS_PER_SECOND
 KEY_LETTERS = "wasd"
 
 
 def action_for(forward: int, turn: int, action_set: str = "default") -> int | None:
     """The action index of ``(forward, turn)`` (each -1, 0 or 1), or None if the action set has no such move."""
-    moves = base.ACTION_SETS[action_set]
+    moves = core.ACTION_SETS[action_set]
     return moves.index((forward, turn)) if (forward, turn) in moves else None
 
 
@@ -164,7 +163,7 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     suite.difficulty_arguments(parser)
     parser.add_argument("--split", default="train", choices=("train", "test"))
-    parser.add_argument("--action-set", default="default", choices=tuple(base.ACTION_SETS))
+    parser.add_argument("--action-set", default="default", choices=tuple(core.ACTION_SETS))
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--keys", default=None, help="headless: key tokens to replay, e.g. 'w w wa d'")
     parser.add_argument("--keys-file", type=pathlib.Path, default=None, help="headless: key tokens from a file")

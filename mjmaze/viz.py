@@ -24,7 +24,7 @@ try:
 except ImportError as error:  # pragma: no cover - depends on the install
     raise ImportError("mjmaze.viz needs Pillow: pip install 'mjmaze[viz]'") from error
 
-from mjmaze import configs, files, mjcf, render, suite
+from mjmaze import configs, core, files, mjcf, physics, render, suite
 from mjmaze.tasks import base
 
 PATH_COLOUR = (255, 255, 255)
@@ -49,7 +49,7 @@ class TopDown:
 
     def __init__(self, env, size: int = 256):
         self.task: base.MazeTask = env.task
-        self.physics: base.MazePhysics = env.physics
+        self.physics: physics.MazePhysics = env.physics
         self.size = int(size)
         layout = self.task.rules.layout
         self.extent = mjcf.overhead_extent(layout.grid_size, layout.cell_size)
@@ -116,7 +116,7 @@ class TopDown:
         if agent_pose is not None:
             x, y, yaw = agent_pose
             cx, cy = self.to_pixels((x, y))
-            r = max(3.0, base.AGENT_RADIUS * self.size / self.extent)
+            r = max(3.0, core.AGENT_RADIUS * self.size / self.extent)
             pen.ellipse((cx - r, cy - r, cx + r, cy + r), fill=AGENT_COLOUR)
             pen.line((cx, cy, cx + 2.2 * r * math.cos(yaw), cy - 2.2 * r * math.sin(yaw)), fill=AGENT_COLOUR,
                      width=width + 1)

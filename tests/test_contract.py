@@ -15,8 +15,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import mjmaze
-from mjmaze import configs, registry, suite
-from mjmaze.tasks import base
+from mjmaze import configs, core, registry, suite
 
 # The fifth scenario (tests/fifth_scenario.py), registered for every test by conftest.
 from fifth_scenario import SCENARIO
@@ -82,7 +81,7 @@ def test_a_full_episode_matches_the_specs(name):
     assert env.action_spec().num_values == 5
     timestep = env.reset()
     steps = 0
-    actions = np.random.default_rng(0).integers(5, size=base.EPISODE_STEPS)
+    actions = np.random.default_rng(0).integers(5, size=core.EPISODE_STEPS)
     while not timestep.last():
         spec.validate(timestep.observation["pixels"])
         timestep = env.step(actions[steps])
@@ -90,8 +89,8 @@ def test_a_full_episode_matches_the_specs(name):
         assert np.isfinite(timestep.reward)
     spec.validate(timestep.observation["pixels"])
     # A task end has discount 0, the time limit discount 1 (no scenario here ends exactly at the limit).
-    assert timestep.discount == (1.0 if steps == base.EPISODE_STEPS else 0.0)
-    assert steps <= base.EPISODE_STEPS
+    assert timestep.discount == (1.0 if steps == core.EPISODE_STEPS else 0.0)
+    assert steps <= core.EPISODE_STEPS
     env.task.close()
 
 
@@ -102,7 +101,7 @@ def test_turning_in_place_ends_at_the_limit_with_discount_one_or_earlier_with_ze
     while not timestep.last():
         timestep = env.step(0)
         steps += 1
-    if steps == base.EPISODE_STEPS:
+    if steps == core.EPISODE_STEPS:
         assert timestep.discount == 1.0
     else:  # the task ended it (Two-colour: health ran out)
         assert timestep.discount == 0.0

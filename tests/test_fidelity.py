@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 import mjmaze
-from mjmaze import doom, layouts, mjcf, palette, render, sprites, walls
-from mjmaze.tasks import base, find_return, k_item, two_colour
+from mjmaze import core, doom, layouts, mjcf, palette, render, sprites, walls
+from mjmaze.tasks import find_return, k_item, two_colour
 
 from conftest import FORWARD, place
 
@@ -223,8 +223,8 @@ def test_the_agent_stops_at_its_radius_from_a_wall_at_every_tic(heading):
     env.task.state["health"][0] = 10**6  # no death in 50 steps
     path = push(env, FORWARD, 50)
     gap = face - path[:, 0]  # centre to wall face
-    assert gap.min() >= base.AGENT_RADIUS - TOLERANCE
-    assert gap[-40:].max() <= base.AGENT_RADIUS + TOLERANCE  # resting against it, no bounce
+    assert gap.min() >= core.AGENT_RADIUS - TOLERANCE
+    assert gap[-40:].max() <= core.AGENT_RADIUS + TOLERANCE  # resting against it, no bounce
     if heading:
         assert path[-1, 1] > -2.0 + 4.0  # slid along the wall
 
@@ -239,7 +239,7 @@ def test_the_agent_slides_along_a_wall_as_slowly_as_in_vizdoom(angle, vizdoom_sl
     face = 5.0  # the outer wall's face is the maze's edge
     place(env, 0.0, face - 0.3, math.radians(90 - angle))  # toward the north wall, angle east of its normal
     path = push(env, FORWARD, 12)[3::4]  # the agent's place after each step
-    assert path[-1, 1] == pytest.approx(face - base.AGENT_RADIUS, abs=TOLERANCE)  # against the wall
+    assert path[-1, 1] == pytest.approx(face - core.AGENT_RADIUS, abs=TOLERANCE)  # against the wall
     slide = (path[-1, 0] - path[-2, 0]) / doom.MAP_UNIT
     assert slide == pytest.approx(vizdoom_slide, rel=0.06)
 
@@ -266,7 +266,7 @@ def test_an_inner_wall_ends_at_its_grid_line():
     x, y = free_wall_end(env)
     place(env, x + 0.6, y, math.pi)
     path = push(env, FORWARD, 20)
-    assert path[-1, 0] == pytest.approx(x + base.AGENT_RADIUS, abs=TOLERANCE)
+    assert path[-1, 0] == pytest.approx(x + core.AGENT_RADIUS, abs=TOLERANCE)
 
 
 def test_the_agent_blocks_as_a_square_at_a_wall_end():
@@ -274,10 +274,10 @@ def test_the_agent_blocks_as_a_square_at_a_wall_end():
     # stop it square-on at its radius, where a round agent would roll round the corner.
     env = load("labyrinth", size=7)
     x, y = free_wall_end(env)
-    lane = y + walls.WALL_THICKNESS / 2 + base.AGENT_RADIUS - 0.02
+    lane = y + walls.WALL_THICKNESS / 2 + core.AGENT_RADIUS - 0.02
     place(env, x + 0.6, lane, math.pi)
     path = push(env, FORWARD, 20)
-    assert path[-1, 0] == pytest.approx(x + base.AGENT_RADIUS, abs=TOLERANCE)
+    assert path[-1, 0] == pytest.approx(x + core.AGENT_RADIUS, abs=TOLERANCE)
     assert path[-1, 1] == pytest.approx(lane, abs=1e-3)
 
 
@@ -302,7 +302,7 @@ def test_the_agent_stops_at_its_radius_from_a_pillar_at_every_tic():
     place(env, red[0] - 0.45, red[1], 0.0)
     path = push(env, FORWARD, 50)
     distance = np.hypot(path[:, 0] - red[0], path[:, 1] - red[1])
-    stop = find_return.PILLAR_RADIUS + base.AGENT_RADIUS
+    stop = find_return.PILLAR_RADIUS + core.AGENT_RADIUS
     assert distance.min() >= stop - TOLERANCE
     assert distance[-40:].max() <= stop + TOLERANCE
     assert env.task.metrics()["target_found"]

@@ -50,7 +50,7 @@ def open_room(head_bob=None, width=320, height=180):
 def eye_units(env):
     """The eye's height above its rest in map units (mjmaze's rest: 0.32 m, 40.96 units; Doom's: 41)."""
     env.task.get_observation(env.physics)  # puts the eye where the view is
-    return env.physics.named.data.cam_xpos[base.CAMERA][2] / doom.MAP_UNIT - mjcf.EYE_HEIGHT / doom.MAP_UNIT
+    return env.physics.named.data.cam_xpos[mjcf.EGO_CAMERA][2] / doom.MAP_UNIT - mjcf.EYE_HEIGHT / doom.MAP_UNIT
 
 
 def pistol_corner(env):

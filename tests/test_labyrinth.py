@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import mjmaze
-from mjmaze import doom
-from mjmaze.tasks import base, labyrinth
+from mjmaze import core, doom, physics
+from mjmaze.tasks import labyrinth
 
 from conftest import FORWARD, TURN_LEFT, TURN_RIGHT, find_cell, place
 
@@ -35,9 +35,9 @@ def test_every_other_step_costs_four_tics(labyrinth9):
 
 def test_time_limit_is_525_agent_steps_and_truncates(labyrinth9):
     env = labyrinth9
-    for step in range(1, base.EPISODE_STEPS + 1):
+    for step in range(1, core.EPISODE_STEPS + 1):
         timestep = env.step(TURN_LEFT)  # spinning in place never reaches the exit
-        if step < base.EPISODE_STEPS:
+        if step < core.EPISODE_STEPS:
             assert timestep.mid(), step
     assert timestep.last()
     assert timestep.discount == 1.0
@@ -79,7 +79,7 @@ def test_forward_gathers_speed_and_coasts_as_in_vizdoom(open_arena):
     moved = _steps(open_arena, [FORWARD] * 12 + [TURN_LEFT] * 6)
     assert moved[:, 0] == pytest.approx(DOOM_FORWARD_FROM_REST + DOOM_COASTING, abs=0.15)
     # Full speed: about a quarter metre per step.
-    assert base.FORWARD_PER_STEP == pytest.approx(33.4 * doom.MAP_UNIT, abs=0.001)
+    assert physics.FORWARD_PER_STEP == pytest.approx(33.4 * doom.MAP_UNIT, abs=0.001)
 
 
 def test_a_turn_starts_slow_as_in_vizdoom(open_arena):
@@ -117,7 +117,7 @@ def test_a_wall_stops_a_forward_run(index):
         px = env.physics.agent_pose()[0]
         assert px <= wall_face - 0.05, "the agent reached into the wall"
     # It is stopped at its radius (0.125 m) from the wall.
-    assert px == pytest.approx(wall_face - base.AGENT_RADIUS, abs=0.01)
+    assert px == pytest.approx(wall_face - core.AGENT_RADIUS, abs=0.01)
     env.task.close()
 
 

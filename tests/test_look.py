@@ -18,7 +18,7 @@ import mjmaze
 from mjmaze import compiled_light, look, mjcf, palette, render, sprites, suite, viz
 from mjmaze.doom import FIRST_OBSERVATION_TIC
 from mjmaze.group import EnvGroup
-from mjmaze.tasks import base, find_return, k_item, labyrinth, two_colour
+from mjmaze.tasks import base, k_item, labyrinth, two_colour
 
 import golden_frames as golden
 from conftest import place
@@ -446,11 +446,6 @@ def object_ahead(name, rgba, distance=2.0):
     colour = object_colour(env, name, (0.0, 0.0, 0.0))
     env.task.close()
     return colour
-
-
-def test_find_return_pillars_are_doom_columns():
-    assert find_return.RED_PILLAR.rgba == palette.TALL_RED_COLUMN_RGBA == two_colour.RED
-    assert find_return.GREEN_PILLAR.rgba == palette.TALL_GREEN_COLUMN_RGBA == two_colour.GREEN
 
 
 def test_the_pistol_when_asked_for_hides_a_floor_item_right_ahead():

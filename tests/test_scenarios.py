@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 import mjmaze
-from mjmaze.tasks import base, k_item, two_colour
+from mjmaze import core, doom, suite
+from mjmaze.tasks import k_item, two_colour
 
 from conftest import FORWARD, TURN_LEFT, place
 
@@ -182,31 +183,33 @@ def test_eleven_green_and_ten_red_items_start_and_one_more_every_thirty_tics_red
     assert list(two_colour.ITEM_GREEN[21:25]) == [False, True, False, True]  # red first, colours alternate
 
 
+def _standing_still(item_cap=None, steps=core.EPISODE_STEPS):
+    """Two-colour's rules alone (no physics, no frames: an agent that stays at its spawn never needs them)
+    for ``steps`` agent steps, the agent kept alive: items spawned after each step, and the last step's
+    ``(reward, terminated, truncated)`` and metrics."""
+    rules = suite.make_rules("two_colour", {"complexity": 1, "item_cap": item_cap})
+    state = rules.start_state(np, rules.config_arrays([rules.configs[0]]), np.zeros(1, dtype=np.int64))
+    path = np.repeat(state["pose"][:, None, :2], doom.TICS_PER_STEP, axis=1)  # every tic at the spawn
+    spawned = []
+    for _ in range(steps):
+        state["health"][:] = 100
+        outcome = rules.step_state(np, state, path)
+        spawned.append(int(state["items_spawned"][0]))
+    return spawned, [value[0] for value in outcome], rules.episode_metrics(state)
+
+
 def test_no_item_cap_by_default_and_an_optional_cap_of_60():
-    uncapped = load("two_colour", complexity=1)
-    capped = load("two_colour", complexity=1, item_cap=60)
-    for _ in range(300):  # tic 1200: 21 + 40 items due; spinning in place
-        for env in (uncapped, capped):
-            env.task.state["health"][0] = 100  # keep the agent alive
-            env.step(TURN_LEFT)
-    assert int(uncapped.task.state["items_spawned"][0]) == 61
-    for _ in range(100):
-        for env in (uncapped, capped):
-            env.task.state["health"][0] = 100
-            env.step(TURN_LEFT)
-    assert int(uncapped.task.state["items_spawned"][0]) == 21 + (400 * 4) // 30  # 74: no cap
-    assert int(capped.task.state["items_spawned"][0]) == 60
+    uncapped, capped = _standing_still(steps=400)[0], _standing_still(item_cap=60, steps=400)[0]
+    assert uncapped[299] == 61  # tic 1200: 21 + 40 items due
+    assert uncapped[-1] == 21 + (400 * 4) // 30  # 74: no cap
+    assert capped[-1] == 60
 
 
 def test_pool_covers_a_full_episode():
-    env = load("two_colour", complexity=1)
-    for _ in range(base.EPISODE_STEPS - 1):
-        env.task.state["health"][0] = 100
-        env.step(TURN_LEFT)
-    timestep = env.step(TURN_LEFT)
-    assert timestep.last() and timestep.discount == 1.0
-    assert int(env.task.state["items_spawned"][0]) == two_colour.POOL_SIZE == 91
-    assert env.task.metrics()["duration"] == 2100
+    spawned, (_, terminated, truncated), metrics = _standing_still()
+    assert truncated and not terminated
+    assert spawned[-1] == two_colour.POOL_SIZE == 91
+    assert metrics["duration"][0] == 2100
 
 
 def test_the_floor_takes_8_health_every_32_tics_and_reaching_zero_ends_the_episode():

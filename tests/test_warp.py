@@ -16,8 +16,7 @@ import numpy as np
 import pytest
 
 import mjmaze
-from mjmaze import look, mjcf, registry, rules, suite
-from mjmaze.tasks import base
+from mjmaze import core, look, mjcf, registry, rules, suite
 
 from conftest import SMALL_SETTINGS
 
@@ -138,7 +137,7 @@ def test_head_bob_moves_each_worlds_eye_and_pistol_as_the_cpu_task():
         for i, env in enumerate(cpus):
             _advance(env, int(actions[i]))
             frame = env.task.get_observation(env.physics)["pixels"]
-            assert eyes[i] == pytest.approx(env.physics.named.data.cam_xpos[base.CAMERA][2], abs=1e-4), (step, i)
+            assert eyes[i] == pytest.approx(env.physics.named.data.cam_xpos[mjcf.EGO_CAMERA][2], abs=1e-4), (step, i)
             # The swayed pistol covers the same pixels (its hand, drawn in its own colour on both).
             assert np.array_equal((obs[i].numpy() == hand).all(-1), (frame == hand).all(-1)), (step, i)
             swing = max(swing, abs(eyes[i] - mjcf.EYE_HEIGHT))
@@ -227,7 +226,7 @@ def test_a_step_never_waits_for_the_device(scenario, mode, monkeypatch):
     ends = 0
     for step in range(6):
         if step % 2 == 0:  # env 0's episode runs out of time on this step: it restarts
-            batch.state["steps"][0] = base.EPISODE_STEPS - 1
+            batch.state["steps"][0] = core.EPISODE_STEPS - 1
         with _no_reads_from_the_device(monkeypatch):
             _, _, terminated, truncated, _ = batch.step(actions)
         ends += int((terminated | truncated).sum())
@@ -243,7 +242,7 @@ def test_a_restarted_world_plays_the_cpu_envs_next_episode(scenario, mode, by_in
     batch = mjwarp.MazeBatchEnv(3, scenario, device="cpu", render=False, autoreset_mode=mode, restart_by_index=by_index, **kwargs)
     batch.reset(seed=SEED)
     cpus = _cpu_twins(scenario, kwargs, 3, batch)
-    batch.state["steps"][1] = base.EPISODE_STEPS - 1  # world 1's episode runs out of time on the next step
+    batch.state["steps"][1] = core.EPISODE_STEPS - 1  # world 1's episode runs out of time on the next step
     actions = torch.tensor([2, 2, 2])
     _, _, _, truncated, _ = batch.step(actions)
     assert truncated.tolist() == [False, True, False]
@@ -306,9 +305,9 @@ def test_outcome_statistics_agree_over_random_episodes(scenario):
     metric = registry.get(scenario).metric
     batch = mjwarp.MazeBatchEnv(EPISODES, scenario, device="cpu", render=False, **kwargs)
     batch.reset(seed=SEED)
-    actions = np.random.default_rng(1).integers(5, size=(base.EPISODE_STEPS, EPISODES))
+    actions = np.random.default_rng(1).integers(5, size=(core.EPISODE_STEPS, EPISODES))
     warp_metric, warp_length = np.full(EPISODES, np.nan), np.zeros(EPISODES)
-    for step in range(base.EPISODE_STEPS):
+    for step in range(core.EPISODE_STEPS):
         _, _, terminated, truncated, info = batch.step(torch.as_tensor(actions[step]))
         ended = (terminated | truncated).numpy() & np.isnan(warp_metric)
         warp_metric[ended] = info[metric].double().numpy()[ended]
@@ -322,7 +321,7 @@ def test_outcome_statistics_agree_over_random_episodes(scenario):
         env.task.rules.first_config = i * num_configs // EPISODES % num_configs
         env.task.reseed(SEED + i)
         env.reset()
-        for step in range(base.EPISODE_STEPS):
+        for step in range(core.EPISODE_STEPS):
             _, terminated, truncated = _advance(env, int(actions[step, i]))
             if terminated or truncated:
                 break

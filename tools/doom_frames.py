@@ -378,7 +378,7 @@ def projection() -> None:
     env.task.close()
     ours = mjmaze.load("labyrinth", task_kwargs={"size": 5, "width": 320, "height": 180})
     ours.reset()
-    model, camera = ours.physics.model.ptr, ours.physics.model.ptr.cam(base.CAMERA).id
+    model, camera = ours.physics.model.ptr, ours.physics.model.ptr.cam(mjcf.EGO_CAMERA).id
     fx, fy = model.cam_intrinsic[camera][:2] / model.cam_sensorsize[camera] * (320, 180)
     ours.task.close()
     print(f"ViZDoom, 320x180: focal {np.mean(across):.1f} px across ({', '.join(f'{v:.1f}' for v in across)}), "

@@ -18,12 +18,13 @@ import numpy as np
 import torch
 
 import mjmaze
-from mjmaze.tasks import base, two_colour
+from mjmaze import core
+from mjmaze.tasks import two_colour
 from mjmaze.train import policy
 
 
 TURN_LEFT, TURN_RIGHT, FORWARD, FORWARD_LEFT, FORWARD_RIGHT = (
-    base.ACTION_NAMES.index(name) for name in ("turn_left", "turn_right", "forward", "forward_left", "forward_right"))
+    core.ACTION_NAMES.index(name) for name in ("turn_left", "turn_right", "forward", "forward_left", "forward_right"))
 
 
 class Seeker:

@@ -22,13 +22,12 @@ import numpy as np
 from tqdm import tqdm
 
 import mjmaze
-from mjmaze import files, suite, viz
-from mjmaze.tasks import base
+from mjmaze import core, files, suite, viz
 
 from . import checkpoint, policy
 from .settings import using_torch_threads
 
-FPS = base.STEPS_PER_SECOND  # real time: one frame per agent step
+FPS = core.STEPS_PER_SECOND  # real time: one frame per agent step
 MAP_SIZE = 256
 
 

@@ -22,16 +22,8 @@ from mjmaze import configs, core, doom, look, mjcf
 from mjmaze.arena import Arena
 from mjmaze.rules import seed_key
 from mjmaze.group import EnvGroup
-# The timing, motion and action names scenario code and tests read as base.*.
-from mjmaze.core import (  # noqa: F401
-    ACTION_NAMES, ACTION_SETS, AGENT_RADIUS, EPISODE_STEPS, STEPS_PER_SECOND,
-)
-from mjmaze.physics import (  # noqa: F401
-    FORWARD_PER_STEP, FRICTION, SLOW_TURN_TICS, THRUST_PER_TIC, TURN_PER_STEP, TURN_PER_TIC, VISIBLE_GROUP,
-    MazePhysics, tic_motion,
-)
-
-CAMERA = mjcf.EGO_CAMERA
+from mjmaze.core import EPISODE_STEPS
+from mjmaze.physics import MazePhysics
 
 
 class MazeTask(base.Task):
