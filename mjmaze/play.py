@@ -22,7 +22,7 @@ import time
 import numpy as np
 
 import mjmaze
-from mjmaze import core, files, suite, viz
+from mjmaze import cli, core, files, suite, viz
 
 STEPS_PER_SECOND = core.STEPS_PER_SECOND
 KEY_LETTERS = "wasd"
@@ -161,7 +161,7 @@ def run_window(session: PlaySession, max_frames: int | None = None) -> None:
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    suite.difficulty_arguments(parser)
+    cli.difficulty_arguments(parser)
     parser.add_argument("--split", default="train", choices=("train", "test"))
     parser.add_argument("--action-set", default="default", choices=tuple(core.ACTION_SETS))
     parser.add_argument("--seed", type=int, default=0)
@@ -171,7 +171,7 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     scenario = args.scenario or suite.DEFAULT_SCENARIO
     out = args.out or pathlib.Path("runs/play") / f"{scenario}_{time.strftime('%Y%m%d-%H%M%S')}"
-    task_kwargs = {"split": args.split, "action_set": args.action_set, **suite.difficulty_kwargs(args)}
+    task_kwargs = {"split": args.split, "action_set": args.action_set, **cli.difficulty_kwargs(args)}
     try:
         session = PlaySession(scenario, task_kwargs, args.seed)
     except ValueError as error:

@@ -13,7 +13,7 @@ import time
 import numpy as np
 
 import mjmaze
-from mjmaze import files, render, suite
+from mjmaze import cli, files, render, suite
 
 
 def frame_strip(frames: list[np.ndarray], scale: int = 2, gap: int = 4) -> np.ndarray:
@@ -60,7 +60,7 @@ def rollout(scenario: str, steps: int, seed: int, strip_frames: int, **task_kwar
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    suite.difficulty_arguments(parser)
+    cli.difficulty_arguments(parser)
     parser.add_argument("--split", default="train", choices=("train", "test"))
     parser.add_argument("--steps", type=int, default=5000, help="agent steps to run")
     parser.add_argument("--seed", type=int, default=0)
@@ -69,7 +69,7 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
 
     args.scenario = args.scenario or suite.DEFAULT_SCENARIO
-    difficulty = suite.difficulty_kwargs(args)
+    difficulty = cli.difficulty_kwargs(args)
     result = rollout(args.scenario, args.steps, args.seed, args.strip_frames, split=args.split, **difficulty)
     print(f"{args.scenario} {difficulty} ({args.split}), random policy, {args.steps} agent steps")
     print(f"  episodes finished : {result['episodes']}")

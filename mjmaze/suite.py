@@ -7,7 +7,6 @@ gymnasium id; a scenario defined elsewhere joins with :func:`register`.
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import importlib
 import inspect
@@ -123,27 +122,3 @@ def load(name: str, task_kwargs: dict | None = None, environment_kwargs: dict | 
       ValueError: unknown name or argument, or a value out of range; the message lists what is valid.
     """
     return base.make_environment(make_task(name, task_kwargs), environment_kwargs)
-
-
-def difficulty_arguments(parser: argparse.ArgumentParser) -> None:
-    """Adds the command-line flags that choose a scenario (default: labyrinth) and its difficulty.
-
-    One flag per difficulty argument of the registered scenarios (``--size``,
-    ``--num-items``, ``--complexity``), each naming the scenarios it sets.
-    """
-    parser.add_argument("--scenario", default=None, choices=registry.names(), help=f"default: {DEFAULT_SCENARIO}")
-    for name, scenarios in difficulty_names().items():
-        parser.add_argument(f"--{name.replace('_', '-')}", type=int, default=None, help=f"{name} ({', '.join(scenarios)})")
-
-
-def difficulty_kwargs(args: argparse.Namespace) -> dict:
-    """The task arguments of the flags added by :func:`difficulty_arguments` that were given."""
-    return {name: getattr(args, name) for name in difficulty_names() if getattr(args, name, None) is not None}
-
-
-def difficulty_names() -> dict[str, list[str]]:
-    """Difficulty argument -> the scenarios it is the difficulty of."""
-    names: dict[str, list[str]] = {}
-    for scenario in registry.all_scenarios():
-        names.setdefault(scenario.difficulty, []).append(scenario.name)
-    return names

@@ -24,7 +24,7 @@ try:
 except ImportError as error:  # pragma: no cover - depends on the install
     raise ImportError("mjmaze.viz needs Pillow: pip install 'mjmaze[viz]'") from error
 
-from mjmaze import configs, core, files, mjcf, physics, render, suite
+from mjmaze import cli, configs, core, files, mjcf, physics, render, suite
 from mjmaze.tasks import base
 
 PATH_COLOUR = (255, 255, 255)
@@ -263,7 +263,7 @@ def main(argv: list[str] | None = None) -> None:
     import mjmaze
 
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    suite.difficulty_arguments(parser)
+    cli.difficulty_arguments(parser)
     parser.add_argument("--split", default="train", choices=configs.SPLITS)
     parser.add_argument("--config", type=int, default=0, help="configuration index in the split")
     parser.add_argument("--random-steps", type=int, default=0, help="draw the path of this many random steps")
@@ -273,7 +273,7 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     try:
         env = mjmaze.load(args.scenario or suite.DEFAULT_SCENARIO, task_kwargs={
-            "split": args.split, "first_config": args.config, "random": args.seed, **suite.difficulty_kwargs(args),
+            "split": args.split, "first_config": args.config, "random": args.seed, **cli.difficulty_kwargs(args),
         })
     except ValueError as error:
         raise SystemExit(f"error: {error}") from None
@@ -292,7 +292,7 @@ def main(argv: list[str] | None = None) -> None:
     env.task.close()
     save_png(args.out, image)
     config = env.task.config
-    print(f"{args.scenario or suite.DEFAULT_SCENARIO} {suite.difficulty_kwargs(args)} {args.split} configuration {config.index}: {args.out}")
+    print(f"{args.scenario or suite.DEFAULT_SCENARIO} {cli.difficulty_kwargs(args)} {args.split} configuration {config.index}: {args.out}")
 
 
 if __name__ == "__main__":

@@ -15,7 +15,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import mjmaze
-from mjmaze import configs, core, registry, suite
+from mjmaze import cli, configs, core, registry, suite
 
 # The fifth scenario (tests/fifth_scenario.py), registered for every test by conftest.
 from fifth_scenario import SCENARIO
@@ -39,9 +39,9 @@ def test_a_fifth_scenario_gets_its_own_configurations_and_flags():
     import argparse
 
     parser = argparse.ArgumentParser()
-    suite.difficulty_arguments(parser)
+    cli.difficulty_arguments(parser)
     args = parser.parse_args(["--scenario", "beacon", "--size", "3"])
-    assert suite.difficulty_kwargs(args) == {"size": 3}
+    assert cli.difficulty_kwargs(args) == {"size": 3}
 
 
 def test_registering_a_clashing_scenario_is_one_clear_error():

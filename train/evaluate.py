@@ -23,7 +23,7 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
-from mjmaze import files, registry, suite
+from mjmaze import cli, files, registry, suite
 from mjmaze.vector import MazeVectorEnv, make_vector_env
 
 from . import checkpoint, policy
@@ -228,11 +228,11 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--plays", type=int, default=PLAYS_PER_CONFIG,
                         help=f"episodes per configuration (default {PLAYS_PER_CONFIG})")
     parser.add_argument("--seed", type=int, default=0, help="seeds the envs' random draws (spawn heading, items)")
-    suite.difficulty_arguments(parser)  # for random: the scenario and its difficulty
+    cli.difficulty_arguments(parser)  # for random: the scenario and its difficulty
     args = parser.parse_args(argv)
     try:
         if str(args.run_dir) == "random":
-            settings = Args(scenario=args.scenario or suite.DEFAULT_SCENARIO, **suite.difficulty_kwargs(args))
+            settings = Args(scenario=args.scenario or suite.DEFAULT_SCENARIO, **cli.difficulty_kwargs(args))
             result = evaluate_random(settings, args.num_envs, args.out, seed=args.seed,
                                      plays_per_config=args.plays)
         else:

@@ -19,7 +19,7 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
-from mjmaze import suite, viz
+from mjmaze import cli, suite, viz
 
 from . import checkpoint, paper_agents
 from .settings import INFERENCE_THREADS, Args
@@ -192,7 +192,7 @@ def policy_arguments(parser: argparse.ArgumentParser) -> None:
                         f"uniformly) or {paper_agents.PREFIX}<setting> (the paper's agent, e.g. paper:two_colour_1)")
     parser.add_argument("--checkpoint", type=pathlib.Path, default=None, help="default: the run's latest")
     parser.add_argument("--sample", action="store_true", help="sample actions instead of the greedy argmax")
-    suite.difficulty_arguments(parser)
+    cli.difficulty_arguments(parser)
     parser.add_argument("--split", default="test", choices=("train", "test"))
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--torch-threads", type=int, default=INFERENCE_THREADS,
@@ -204,7 +204,7 @@ def policy_from_arguments(args: argparse.Namespace) -> tuple[str, dict, Policy, 
 
     A run decides the scenario and difficulty (flags saying otherwise are an error).
     """
-    flags = suite.difficulty_kwargs(args)
+    flags = cli.difficulty_kwargs(args)
     if args.source == RANDOM:
         scenario = args.scenario or suite.DEFAULT_SCENARIO
         task_kwargs = Args(scenario=scenario, **flags).task_kwargs()  # checks the scenario and flags

@@ -13,7 +13,7 @@ from typing import Annotated
 import torch
 import tyro
 
-from mjmaze import registry, suite
+from mjmaze import cli, registry, suite
 
 
 @dataclasses.dataclass
@@ -116,11 +116,11 @@ class _RunSettings:
 
 # One flag per difficulty argument of the registered scenarios (--size,
 # --num-items, --complexity), read from the registry like the other tools'
-# flags (mjmaze.suite.difficulty_arguments): a scenario added in mjmaze/tasks/
+# flags (mjmaze.cli.difficulty_arguments): a scenario added in mjmaze/tasks/
 # brings its own.
 DIFFICULTY_FLAGS = {
     name: f"the difficulty of {', '.join(scenarios)} (None: the scenario's default)"
-    for name, scenarios in suite.difficulty_names().items()
+    for name, scenarios in cli.difficulty_names().items()
 }
 Args = dataclasses.make_dataclass(
     "Args",
