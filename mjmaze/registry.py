@@ -15,7 +15,6 @@ This module imports nothing of mjmaze, so any module may read it.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping
 
 
 @dataclasses.dataclass(frozen=True)
@@ -33,29 +32,17 @@ class Scenario:
         across scenarios.
       difficulty: the task argument that sets the difficulty (``"size"``).
       difficulties: its valid values.
-      paper_difficulties: the values of the paper's Table 2.
       metric: the ``info`` field of the headline metric (per episode).
       metric_scale: factor from that field's mean to the paper's units.
       metric_units: those units, for tables and plots (``"success %"``).
-      metric_digits: decimals to print the metric with.
       cell_size: grid cell size in metres (for imported layouts).
-      landmark: what analysis marks the first sighting of (object 0).
-      paper_results: difficulty -> (train mean, train std, test mean, test std)
-        of the paper's Table 2 (200M steps, 3 seeds).
       item_codes: for layouts that list coloured items (``items`` of
         ``[x, y, code]``), the codes in collection order; ``None`` for layouts
         with ``start`` and ``end``.
       imported_spawn_may_share_a_cell: whether an imported layout may put the
         spawn in an object's cell (the released Two-colour generator did).
-      paper_curves: difficulty -> ``((agent steps, value), ...)``: the paper's
-        training curve (A2C, mean of 3 seeds), read by eye off the plots released
-        with its implementation (edbeeching/3D_Control_RL_Scenario_Benchmarks,
-        ``results/``; their x axis counts frames, 4 per agent step), see
-        :func:`paper_curve`.
-      paper_curve_field: the ``info`` field those curves plot (``""``: ``metric``).
-      paper_curve_scale: factor from that field's mean to the curves' units
-        (None: ``metric_scale``).
-      paper_curve_units: the curves' units (``""``: ``metric_units``).
+
+    The paper's published numbers (Table 2, its curves) are :mod:`mjmaze.train.published`'s.
     """
 
     name: str
@@ -64,45 +51,12 @@ class Scenario:
     seed_code: int
     difficulty: str
     difficulties: tuple[int, ...]
-    paper_difficulties: tuple[int, ...]
     metric: str
     metric_scale: float
     metric_units: str
-    metric_digits: int
     cell_size: float
-    landmark: str
-    paper_results: Mapping[int, tuple[float, float, float, float]] = dataclasses.field(default_factory=dict)
     item_codes: tuple[str, ...] | None = None
     imported_spawn_may_share_a_cell: bool = False
-    paper_curves: Mapping[int, tuple[tuple[int, float], ...]] = dataclasses.field(default_factory=dict)
-    paper_curve_field: str = ""
-    paper_curve_scale: float | None = None
-    paper_curve_units: str = ""
-
-    @property
-    def curve_field(self) -> str:
-        """The ``info`` field the paper's curves plot."""
-        return self.paper_curve_field or self.metric
-
-    @property
-    def curve_scale(self) -> float:
-        return self.metric_scale if self.paper_curve_scale is None else self.paper_curve_scale
-
-    @property
-    def curve_units(self) -> str:
-        return self.paper_curve_units or self.metric_units
-
-
-#: Agent steps at which the paper's curves were read (its plots' 10M, 20M, 40M,
-#: 100M, 200M and 800M frames).
-PAPER_CURVE_STEPS = (2_500_000, 5_000_000, 10_000_000, 25_000_000, 50_000_000, 200_000_000)
-
-
-def paper_curve(values: tuple[float, ...]) -> tuple[tuple[int, float], ...]:
-    """``((agent steps, value), ...)`` from values read at :data:`PAPER_CURVE_STEPS`."""
-    if len(values) != len(PAPER_CURVE_STEPS):
-        raise ValueError(f"a paper curve has {len(PAPER_CURVE_STEPS)} values, got {len(values)}")
-    return tuple(zip(PAPER_CURVE_STEPS, values))
 
 
 _SCENARIOS: dict[str, Scenario] = {}

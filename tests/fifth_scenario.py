@@ -40,6 +40,5 @@ class Beacon(core.MazeRules):
 
 SCENARIO = registry.Scenario(
     name="beacon", task=Beacon, gym_id="mjmaze_test/Beacon-v0", seed_code=1001, difficulty="size",
-    difficulties=(3, 4), paper_difficulties=(), metric="reached", metric_scale=100.0, metric_units="reached %",
-    metric_digits=1, cell_size=1.0, landmark="beacon",
+    difficulties=(3, 4), metric="reached", metric_scale=100.0, metric_units="reached %", cell_size=1.0,
 )

@@ -8,6 +8,7 @@ import pytest
 import mjmaze
 from mjmaze import core, doom, suite
 from mjmaze.tasks import k_item, two_colour
+from mjmaze.train import published
 
 from conftest import FORWARD, TURN_LEFT, place
 
@@ -86,7 +87,7 @@ def test_right_then_wrong_item_ends_the_episode():
         {"items_in_order": 1, "item_score": 0.25, "normalised_return": (0.5 - 0.25 + 2 * STEP) / 2.0})
 
 
-@pytest.mark.parametrize("num_items", k_item.PAPER_NUM_ITEMS)
+@pytest.mark.parametrize("num_items", published.of("k_item").difficulties)
 def test_all_items_in_order_pay_once_each_and_end_the_episode(num_items):
     env = load("k_item", num_items=num_items)
     total = 0.0

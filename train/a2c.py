@@ -37,7 +37,7 @@ from torch.nn import functional as F
 from mjmaze import files, registry, suite
 from mjmaze.vector import WorkerError, make_vector_env
 
-from . import checkpoint
+from . import checkpoint, published
 from .model import Agent
 from .settings import Args, pick_device
 
@@ -134,8 +134,7 @@ def _loop(args, make_envs, envs, agent, optimizer, device, run_dir, step, update
     n, T = args.num_envs, args.num_steps
     metric, scale, _ = suite.paper_metric(args.scenario)
     # The field the paper's training curves plot, where it is not the metric (K-item's normalised return).
-    declared = registry.get(args.scenario)
-    curve_field = declared.curve_field if declared.curve_field != metric else None
+    curve_field = published.curve_field(args.scenario) if published.curve_field(args.scenario) != metric else None
     # Rollout buffers where the envs put their results (the GPU with the Warp backend).
     buffers = device if args.backend == "warp" else torch.device("cpu")
     actions = torch.zeros((T, n), dtype=torch.long, device=buffers)
@@ -240,7 +239,7 @@ def _loop(args, make_envs, envs, agent, optimizer, device, run_dir, step, update
                 record["episode_return"] = float(np.mean([e["episode_return"] for e in finished]))
                 record[metric] = float(np.mean([e[metric] for e in finished])) * scale
                 if curve_field:
-                    record[curve_field] = float(np.mean([e[curve_field] for e in finished])) * declared.curve_scale
+                    record[curve_field] = float(np.mean([e[curve_field] for e in finished])) * published.curve_scale(args.scenario)
             metrics_file.write(json.dumps(record) + "\n")
             metrics_file.flush()
             for key in ("policy_loss", "value_loss", "entropy"):

@@ -37,9 +37,9 @@ import numpy as np
 from matplotlib.figure import Figure
 
 import mjmaze
-from mjmaze import files, registry, suite
+from mjmaze import files, suite
 
-from . import checkpoint, policy
+from . import checkpoint, policy, published
 from .settings import using_torch_threads
 
 TSNE_STATES = 2000
@@ -78,7 +78,7 @@ def heatmap(episode: policy.Episode, scenario: str, title: str) -> Figure:
     seen = episode.landmark_first_seen
     if seen is not None and seen < episode.length:
         axes.axvline(seen, color="k", linestyle="--", linewidth=1.5,
-                     label=f"{registry.get(scenario).landmark} first in view (step {seen})")
+                     label=f"{published.landmark(scenario)} first in view (step {seen})")
         axes.legend(loc="upper right", fontsize=8, framealpha=0.9)
     axes.set_xlabel("step")
     axes.set_ylabel("hidden unit")
@@ -199,7 +199,7 @@ def analyse(source_args: argparse.Namespace, episodes: int, out: pathlib.Path | 
     summary = {
         "source": source_args.source, "description": description, "scenario": scenario, "task_kwargs": task_kwargs,
         "split": source_args.split, "states": len(hidden), "tsne_points": len(embedding),
-        "landmark": registry.get(scenario).landmark, "metric_units": units, "heatmap_episode": heatmap_episode,
+        "landmark": published.landmark(scenario), "metric_units": units, "heatmap_episode": heatmap_episode,
         **({"totem_probe": probe} if totem_green is not None else {}),
         "episodes": [
             {"config_index": e.config_index, "length": e.length, "return": float(e.rewards.sum()),

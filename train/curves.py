@@ -10,7 +10,7 @@ and share a panel. Solid: the training episodes' value from ``metrics.jsonl``
 bins from the step at which the first episodes can reach the time limit (before
 it only the episodes that ended early have ended: a Labyrinth run's curve would
 start at its few quick successes). Black squares: the paper's own curve at that difficulty, read off its
-released plots (``mjmaze.registry.Scenario.paper_curves``). With
+released plots (``mjmaze.train.published``). With
 ``--evaluate`` (or where a run already has them), greedy evaluations of each
 kept checkpoint on the training and test configurations (``mjmaze.train.evaluate``,
 cached in ``<run>/evals/step_N.json``) are drawn as markers. Writes the PNG and
@@ -29,7 +29,7 @@ from tqdm import tqdm
 
 from mjmaze import core, files, registry
 
-from . import checkpoint, evaluate, paper_agents
+from . import checkpoint, evaluate, paper_agents, published
 from .analysis import save_figure
 
 BINS = 40
@@ -41,7 +41,7 @@ def read_run(run_dir: pathlib.Path) -> dict:
     if not config_file.exists():
         raise FileNotFoundError(f"{run_dir} is not a training run (no config.json)")
     config = json.loads(config_file.read_text())
-    field = registry.get(config["scenario"]).curve_field
+    field = published.curve_field(config["scenario"])
     steps, values = [], []
     metrics_file = run_dir / "metrics.jsonl"
     if metrics_file.exists():
@@ -151,7 +151,7 @@ def released_group(source: str) -> dict:
     result = json.loads(path.read_text())
     declared = registry.get(info.scenario)
     return {"label": f"{source} (the paper's agent, {info.observations / 1e6:.0f}M)", "scenario": info.scenario,
-            "setting": f"{info.scenario} {declared.difficulty}={info.difficulty}", "units": declared.curve_units,
+            "setting": f"{info.scenario} {declared.difficulty}={info.difficulty}", "units": published.curve_units(info.scenario),
             "eval_units": declared.metric_units, "runs": [source],
             "released": {split: result[split]["curve_value"] for split in ("train", "test")}}
 
@@ -173,9 +173,9 @@ def curves(run_dirs: list[pathlib.Path | str], bins: int = BINS, each_run: bool 
     for key, runs in groups.items():
         config = runs[0]["config"]
         declared = registry.get(config["scenario"])
-        paper = declared.paper_curves.get(config.get(declared.difficulty), ()) if not config.get("num_configs") else ()
+        paper = published.of(config["scenario"]).curves.get(config.get(declared.difficulty), ()) if not config.get("num_configs") else ()
         result.append({
-            "label": key[0] if each_run else label(config), "setting": setting(config), "scenario": config["scenario"], "units": declared.curve_units,
+            "label": key[0] if each_run else label(config), "setting": setting(config), "scenario": config["scenario"], "units": published.curve_units(config["scenario"]),
             "eval_units": declared.metric_units,
             "runs": [r["dir"] for r in runs], "training": binned(runs, bins), "evaluations": evaluations(runs),
             "paper": {"step": [s for s, _ in paper], "value": [v for _, v in paper]},
@@ -225,7 +225,7 @@ def figure(groups: list[dict], title: str = "") -> Figure:
     for ax, scenario in zip(axes, scenarios):
         ax.set_title(scenario, fontsize=10)
         ax.set_xlabel("agent steps (observations)")
-        ax.set_ylabel(registry.get(scenario).curve_units)
+        ax.set_ylabel(published.curve_units(scenario))
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="best")
     if title:

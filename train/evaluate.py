@@ -26,7 +26,7 @@ from tqdm import tqdm
 from mjmaze import cli, files, registry, suite
 from mjmaze.vector import MazeVectorEnv, make_vector_env
 
-from . import checkpoint, policy
+from . import checkpoint, policy, published
 from .model import Agent
 from .settings import INFERENCE_THREADS, Args, pick_device, using_torch_threads
 
@@ -81,7 +81,6 @@ def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, devic
                                keep_final_obs=False, split=split, num_configs=num_configs, config_sampling="cycle",
                                **task_kwargs)
     metric, scale, _ = suite.paper_metric(args.scenario)
-    declared = registry.get(args.scenario)
     random_actions = np.random.default_rng(seed)
     draws = torch.Generator(device=device).manual_seed(seed)  # sampled actions
     episodes: list[list[dict]] = [[] for _ in range(num_envs)]
@@ -126,7 +125,7 @@ def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, devic
         "mean_return": float(np.mean([e["episode_return"] for e in played])),
         "mean_length": float(np.mean([e["length"] for e in played])),  # agent steps
         # In the units of the paper's training curves (the metric but for K-item's normalised return).
-        "curve_value": float(np.mean([e[declared.curve_field] for e in played])) * declared.curve_scale,
+        "curve_value": float(np.mean([e[published.curve_field(args.scenario)] for e in played])) * published.curve_scale(args.scenario),
         "configs": sorted(e["config_index"] for e in played),
         "seed": seed, "plays_per_config": plays_per_config, "actions": "sampled" if sampled else "greedy",
         # Each episode's (configuration, metric in the table's units, agent steps): paper_table's intervals.

@@ -37,7 +37,7 @@ import numpy as np
 
 from mjmaze import files, registry
 
-from . import evaluate, paper_agents
+from . import evaluate, paper_agents, published
 from .settings import INFERENCE_THREADS
 
 SCORE_TOLERANCE = 0.10  # of ViZDoom's score (or of the whole range for success %, item score)
@@ -114,8 +114,7 @@ def rows(mjmaze_results: dict[str, dict], vizdoom_results: dict[str, dict]) -> l
     table = []
     for name, result in mjmaze_results.items():
         info = paper_agents.get(name)
-        declared = registry.get(info.scenario)
-        paper = declared.paper_results.get(info.difficulty)
+        paper = published.of(info.scenario).results.get(info.difficulty)
         doom = vizdoom_results.get(name)
         row = {
             "setting": name, "scenario": info.scenario, "difficulty": info.difficulty, "units": result["units"],
@@ -160,7 +159,7 @@ def markdown(table: list[dict]) -> str:
         "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for row in table:
-        digits = registry.get(row["scenario"]).metric_digits
+        digits = published.of(row["scenario"]).metric_digits
         cells = [row["setting"], row["units"]]
         for split in ("train", "test"):
             paper = row["paper"]

@@ -29,9 +29,9 @@ import numpy as np
 
 from mjmaze import files, registry, suite
 
-from . import curves
+from . import curves, published
 
-# The paper's Table 2 is each scenario's ``paper_results`` in mjmaze.registry.
+# The paper's Table 2 is each scenario's ``results`` in mjmaze.train.published.
 PAPER_STEPS = 200_000_000
 CSV_FIELDS = ("scenario", "env_ids", "difficulty_name", "difficulty", "num_configs", "units", "seeds", "evaluated", "steps",
               "episodes",
@@ -59,7 +59,7 @@ def collect(sweep_dir: pathlib.Path) -> tuple[list[dict], list[pathlib.Path]]:
         evaluated = [r for _, r in runs if r is not None]
         train = np.array([r["train"]["value"] for r in evaluated])
         test = np.array([r["test"]["value"] for r in evaluated])
-        paper = registry.get(scenario).paper_results.get(difficulty) if num_configs is None else None
+        paper = published.of(scenario).results.get(difficulty) if num_configs is None else None
         rows.append({
             "scenario": scenario, "difficulty_name": registry.get(scenario).difficulty, "difficulty": difficulty,
             "num_configs": num_configs, "units": suite.paper_metric(scenario)[2], "seeds": len(runs),
@@ -83,7 +83,7 @@ def _order(key: tuple) -> tuple:
 def _cell(mean, std, scenario: str) -> str:
     if mean is None:
         return "-"
-    digits = registry.get(scenario).metric_digits
+    digits = published.of(scenario).metric_digits
     return f"{mean:.{digits}f} ± {std:.{digits}f}"
 
 

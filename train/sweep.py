@@ -35,7 +35,7 @@ from tqdm import tqdm
 
 from mjmaze import files, registry, suite
 
-from . import a2c, checkpoint, evaluate
+from . import a2c, checkpoint, evaluate, published
 from .settings import Args
 
 GENERALISATION_CONFIGS = (16, 64, 256, 1024)
@@ -85,7 +85,7 @@ def grid(name: str, seeds: list[int] | None = None, scenario: str | None = None,
         return [
             RunSpec(scenario, d, seed)
             for scenario in suite.ALL_TASKS
-            for d in registry.get(scenario).paper_difficulties
+            for d in published.of(scenario).difficulties
             for seed in seeds
         ]
     if name == "generalisation":

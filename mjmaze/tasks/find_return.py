@@ -30,7 +30,6 @@ if __doc__:  # python -OO drops docstrings
 
 
 SIZES = (5, 7, 9, 11, 13)
-PAPER_SIZES = (7, 9, 11, 13)
 DEFAULT_SIZE = 9
 CELL_SIZE = 1.0
 TARGET_REWARD = 0.5
@@ -102,18 +101,8 @@ SCENARIO = registry.Scenario(
     seed_code=2,
     difficulty="size",
     difficulties=SIZES,
-    paper_difficulties=PAPER_SIZES,
     metric="success",
     metric_scale=100.0,
     metric_units="success %",
-    metric_digits=1,
     cell_size=CELL_SIZE,
-    landmark="red pillar",
-    paper_results={7: (98.7, 0.3, 95.1, 0.2), 9: (87.0, 1.9, 81.6, 1.8), 11: (70.9, 1.6, 64.0, 1.6), 13: (57.7, 0.8, 52.9, 3.7)},
-    # Training success %, read off the released plots (see registry.Scenario.paper_curves).
-    paper_curves={
-        5: registry.paper_curve((35, 58, 75, 85, 93, 96)),
-        7: registry.paper_curve((30, 50, 63, 72, 82, 94)),
-        9: registry.paper_curve((15, 30, 45, 55, 60, 81)),
-    },
 )

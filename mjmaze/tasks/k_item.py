@@ -34,7 +34,6 @@ if __doc__:  # python -OO drops docstrings
 
 
 NUM_ITEMS = tuple(range(1, 9))
-PAPER_NUM_ITEMS = (2, 4, 6, 8)
 DEFAULT_NUM_ITEMS = 4
 DEFAULT_SIZE = 5
 SIZES = tuple(range(2, 14))
@@ -126,24 +125,9 @@ SCENARIO = registry.Scenario(
     seed_code=3,
     difficulty="num_items",
     difficulties=NUM_ITEMS,
-    paper_difficulties=PAPER_NUM_ITEMS,
     metric="item_score",
     metric_scale=1.0,
     metric_units="items in order / K",
-    metric_digits=3,
     cell_size=CELL_SIZE,
-    landmark="first item",
-    paper_results={
-        2: (0.968, 0.004, 0.932, 0.012), 4: (0.910, 0.012, 0.861, 0.015),
-        6: (0.577, 0.024, 0.522, 0.023), 8: (0.084, 0.071, 0.083, 0.070),
-    },
     item_codes=tuple(code for code, _ in KINDS),
-    # The released plots show the return over its most (K x 0.5), not items in order / K.
-    paper_curves={
-        2: registry.paper_curve((-0.2, -0.2, 0.05, 0.3, 0.78, 0.92)),
-        4: registry.paper_curve((-0.1, -0.1, -0.05, 0.05, 0.1, 0.86)),
-    },
-    paper_curve_field="normalised_return",
-    paper_curve_scale=1.0,
-    paper_curve_units="return / (K x 0.5)",
 )

@@ -29,7 +29,6 @@ if __doc__:  # python -OO drops docstrings
 
 
 SIZES = (5, 7, 9, 11, 13)
-PAPER_SIZES = (7, 9, 11, 13)
 DEFAULT_SIZE = 9
 CELL_SIZE = 1.0
 EXIT_REWARD = 1.0
@@ -77,19 +76,8 @@ SCENARIO = registry.Scenario(
     seed_code=1,
     difficulty="size",
     difficulties=SIZES,
-    paper_difficulties=PAPER_SIZES,
     metric="success",
     metric_scale=100.0,
     metric_units="success %",
-    metric_digits=1,
     cell_size=CELL_SIZE,
-    landmark="exit",
-    paper_results={7: (99.8, 0.2, 99.5, 0.2), 9: (98.1, 0.8, 97.4, 1.3), 11: (95.2, 0.7, 90.1, 1.0), 13: (84.1, 1.8, 79.8, 1.9)},
-    # Training success %, read off the released plots (see registry.Scenario.paper_curves).
-    paper_curves={
-        7: registry.paper_curve((40, 65, 80, 90, 97, 99)),
-        9: registry.paper_curve((25, 45, 70, 80, 88, 95)),
-        11: registry.paper_curve((10, 25, 45, 70, 80, 88)),
-        13: registry.paper_curve((5, 15, 40, 60, 70, 77)),
-    },
 )

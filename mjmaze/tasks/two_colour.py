@@ -51,7 +51,6 @@ if __doc__:  # python -OO drops docstrings
 
 
 COMPLEXITIES = tuple(range(0, 11))
-PAPER_COMPLEXITIES = (1, 3, 5, 7)
 DEFAULT_COMPLEXITY = 3
 GRID_SIZE = 5
 CELL_SIZE = 2.0
@@ -303,21 +302,11 @@ SCENARIO = registry.Scenario(
     seed_code=4,
     difficulty="complexity",
     difficulties=COMPLEXITIES,
-    paper_difficulties=PAPER_COMPLEXITIES,
     metric="duration",
     metric_scale=1.0,
     metric_units="tics survived",
-    metric_digits=0,
     cell_size=CELL_SIZE,
-    landmark="totem",
-    paper_results={1: (1903, 27, 1941, 4), 3: (1789, 24, 1781, 24), 5: (1436, 158, 1432, 161), 7: (1159, 126, 1128, 140)},
     # The released generator could spawn the agent in the totem's cell; such
     # an imported layout plays as released (see TwoColour).
     imported_spawn_may_share_a_cell=True,
-    # Tics survived in training episodes, read off the released plots (see registry.Scenario.paper_curves).
-    paper_curves={
-        1: registry.paper_curve((430, 530, 700, 850, 1100, 1920)),
-        3: registry.paper_curve((430, 530, 720, 1000, 1100, 1750)),
-        7: registry.paper_curve((410, 470, 650, 780, 900, 1100)),
-    },
 )
