@@ -62,7 +62,7 @@ class EpisodeState(TypedDict, total=False):
     steps: Any  #: ``(B,)`` int64: agent steps taken
     episode_return: Any  #: ``(B,)`` float64: the return so far
     animation_start: Any  #: ``(B, objects)`` int64: where each object's animation began (:meth:`MazeRules.animation_start`)
-    damage_count: Any  #: ``(B,)`` int64: Doom's red flash counter (:func:`mjmaze.rules.flash`)
+    damage_count: Any  #: ``(B,)`` int64: Doom's red flash counter (:func:`mjmaze.look.flash_tint`)
     bonus_count: Any  #: ``(B,)`` int64: Doom's gold flash counter
 
 
@@ -193,7 +193,7 @@ class MazeRules(abc.ABC):
         state["animation_start"] = self.animation_start(xp, keys)
         state["steps"] = xp.zeros(keys.shape, dtype=xp.int64, device=rules.device(keys))
         state["episode_return"] = xp.zeros(keys.shape, dtype=xp.float64, device=rules.device(keys))
-        # Doom's flash counters (mjmaze.rules.flash); a scenario's rules set them.
+        # Doom's flash counters (mjmaze.rules; their tint: mjmaze.look.flash_tint); a scenario's rules set them.
         for name in ("damage_count", "bonus_count"):
             state.setdefault(name, xp.zeros(keys.shape, dtype=xp.int64, device=rules.device(keys)))
         return state

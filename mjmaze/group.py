@@ -203,7 +203,7 @@ class EnvGroup:
             return None
         model = self._models[row]
         groups = model.geom_group[self._sprite_ids]
-        model.geom_group[self._sprite_ids[unseen]] = render.HIDDEN_GROUP
+        model.geom_group[self._sprite_ids[unseen]] = mjcf.HIDDEN_GROUP
         return groups
 
     def _sprite_xy(self, rows: list[int]) -> np.ndarray | None:

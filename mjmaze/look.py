@@ -36,7 +36,7 @@ class View:
     visual_style: str = "textured"
     #: Doom's head-bob while walking: the eye swings, the pistol sways (:func:`view_bob`).
     head_bob: bool = True
-    #: Doom's full-screen flashes: red when hurt, gold on a pickup (:func:`mjmaze.rules.flash`).
+    #: Doom's full-screen flashes: red when hurt, gold on a pickup (:func:`flash_tint`).
     flashes: bool = True
 
     def __post_init__(self):
@@ -69,7 +69,6 @@ class View:
 # in units per tic, with a 20-tic period, and drops and sways the pistol by the
 # whole bob (in 320x180 screen pixels) with a 64-tic period. The phases run on
 # the level's clock, which the released configs start at tic 10.
-MAX_BOB = 16.0  # map units (Doom's MAXBOB)
 EYE_BOB_TICS = 20
 PISTOL_BOB_TICS = 64
 PISTOL_BOB_PIXELS = (0.751 / 320, 0.903 / 180)  # (x, y) shift per unit of bob, as fractions of the frame
@@ -83,12 +82,6 @@ PISTOL = (
     ((0.472, 0.541, 0.644, 0.806), (55, 51, 49)),  # the gun
     ((0.444, 0.569, 0.806, 1.0), (92, 63, 36)),  # the hand holding it
 )
-
-
-def walking_bob(xp, vx, vy, timestep: float):
-    """Doom's bob in map units of a tic whose velocity after its thrust is ``(vx, vy)`` (m/s)."""
-    speed_sq = (vx * vx + vy * vy) * (timestep / doom.MAP_UNIT) ** 2  # (map units per tic)^2
-    return rules.at_most(xp, speed_sq / 4, MAX_BOB)
 
 
 def view_bob(xp, bob, tics):
@@ -234,7 +227,7 @@ class SpriteView:
 def tint(xp, frames, rgb, alpha):
     """``frames`` (uint8 ``(..., H, W, 3)``) under a full-screen tint: ``rgb`` ``(..., 3)`` at opacity ``alpha`` ``(...)``.
 
-    Doom's flashes (:func:`mjmaze.rules.flash`), on numpy frames or torch
+    Doom's flashes (:func:`flash_tint`), on numpy frames or torch
     batches alike; returns new uint8 frames, rounded as GL blends.
     """
     alpha = xp.astype(alpha, xp.float32)[..., None, None, None]
@@ -243,8 +236,8 @@ def tint(xp, frames, rgb, alpha):
 
 
 def flash(xp, frames, damage_count, bonus_count):
-    """``frames`` ``(B, H, W, 3)`` under each env's flash, from its counters ``(B,)`` (:func:`mjmaze.rules.flash`)."""
-    return tint(xp, frames, *rules.flash(xp, damage_count, bonus_count))
+    """``frames`` ``(B, H, W, 3)`` under each env's flash, from its counters ``(B,)`` (:func:`flash_tint`)."""
+    return tint(xp, frames, *flash_tint(xp, damage_count, bonus_count))
 
 
 # Doom's light (palette.DepthLight), applied to a frame GL or MuJoCo Warp drew
@@ -372,6 +365,37 @@ class DoomLight:
         return xp.astype(lit + self._half, xp.uint8)
 
 
+# Doom's full-screen flashes: the tint of the rules' counters (mjmaze.rules: damage_count,
+# bonus_count), as ZDoom blends them (v_blend.cpp; measured in ViZDoom, docs/look.md).
+DAMAGE_RGB = (255, 0, 0)
+BONUS_RGB = (215, 186, 69)
+# ZDoom's red opacity (of 255) for a damage count: a log scale, capped at 175
+# (the table stops where the cap takes over).
+DAMAGE_TO_ALPHA = (
+    0, 8, 16, 23, 30, 36, 42, 47, 53, 58, 62, 67, 71, 75, 79, 83, 87, 90, 94, 97, 100, 103, 107, 109, 112, 115,
+    118, 120, 123, 125, 128, 130, 133, 135, 137, 139, 141, 143, 145, 147, 149, 151, 153, 155, 157, 159, 160, 162,
+    164, 165, 167, 169, 170, 172, 173, 175,
+)  # the table goes on to 113 -> 237, all above the cap
+MAX_FLASH_ALPHA = 0.5  # ZDoom keeps at least half of the view
+
+
+def flash_tint(xp, damage_count, bonus_count) -> tuple:
+    """``(rgb (B, 3), alpha (B,))``: the tint over each env's view; ``frame * (1 - alpha) + rgb * alpha``.
+
+    ZDoom adds the gold, then the red, as layers (``AddBlend``) and caps the
+    sum's opacity at :data:`MAX_FLASH_ALPHA`.
+    """
+    dev = rules.device(damage_count)
+    table = rules.constant(xp, DAMAGE_TO_ALPHA, xp.float64, dev)
+    red = table[xp.clip(damage_count, max=len(DAMAGE_TO_ALPHA) - 1)] / 255
+    gold = xp.astype(xp.clip(bonus_count * 8, max=128), xp.float64) / 255
+    alpha = gold + (1 - gold) * red
+    gold_share = xp.where(alpha > 0, gold / xp.where(alpha > 0, alpha, 1.0), 0.0)
+    rgb = (gold_share[:, None] * rules.constant(xp, BONUS_RGB, xp.float64, dev)
+           + (1 - gold_share[:, None]) * rules.constant(xp, DAMAGE_RGB, xp.float64, dev))
+    return rgb, xp.clip(alpha, max=MAX_FLASH_ALPHA)
+
+
 class FramePipeline:
     """What Doom draws beyond the 3D scene, for a batch of views: the one path of both backends.
 
@@ -450,9 +474,9 @@ class FramePipeline:
             for row in np.flatnonzero((damage > 0) | (bonus > 0)):
                 counts = int(damage[row]), int(bonus[row])
                 if counts not in self._tints:  # a few dozen pairs occur: each worked out once
-                    rgb, alpha = rules.flash(np, np.array(counts[:1]), np.array(counts[1:]))
+                    rgb, alpha = flash_tint(np, np.array(counts[:1]), np.array(counts[1:]))
                     self._tints[counts] = rgb[0], alpha[0]
                 frames[row] = tint(xp, frames[row], *self._tints[counts])
         elif self._flashes:  # every world, flashed or not: picking the flashed ones out would wait on the GPU
-            frames = tint(xp, frames, *rules.flash(xp, state["damage_count"], state["bonus_count"]))
+            frames = tint(xp, frames, *flash_tint(xp, state["damage_count"], state["bonus_count"]))
         return frames

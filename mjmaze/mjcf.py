@@ -36,7 +36,8 @@ VISUAL_STYLES = ("textured", "flat")
 #: million, so they stay (CHANGELOG.md, "Speed measurements").
 LIT_QUAD = 0.5
 EGO_CAMERA = "ego"  # the agent's eye (xml_templates/arena.xml)
-VISIBLE_GROUP = 1  # the geom group of an object the agent sees (mjmaze.render.HIDDEN_GROUP: one it does not)
+VISIBLE_GROUP = 1  # the geom group of an object the agent sees
+HIDDEN_GROUP = 5  # the geom group of one it does not (no renderer draws group 5)
 ARENA_BODY = "arena"  # build_xml's batch arena: the body holding what differs between worlds
 COLLISION_SUFFIX = "_collision"  # a colliding object's blocking twin (build_xml's _blocking_square)
 OVERHEAD_CAMERA = "overhead"

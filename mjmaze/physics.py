@@ -17,7 +17,7 @@ import mujoco as mj
 import numpy as np
 from dm_control import mujoco
 
-from mjmaze import core, doom, look, mjcf, render
+from mjmaze import core, doom, mjcf, rules
 
 if TYPE_CHECKING:
     from mjmaze.arena import ArenaIds
@@ -119,7 +119,7 @@ class MazePhysics(mujoco.Physics):
         qvel[0], qvel[1] = vx, vy
         self.turn_held = held
         if nstep:
-            self.bob = float(look.walking_bob(np, thrust_vx, thrust_vy, dt))
+            self.bob = float(walking_bob(np, thrust_vx, thrust_vy, dt))
 
     def agent_pose(self) -> tuple[float, float, float]:
         """``(x, y, yaw)`` of the agent; yaw in radians in ``(-pi, pi]``, 0 facing +x."""
@@ -154,7 +154,7 @@ class MazePhysics(mujoco.Physics):
 
     def show_objects(self, geom_ids, visible) -> None:
         """Shows (True) or hides (False) objects in the agent's view."""
-        self.model.ptr.geom_group[geom_ids] = np.where(visible, VISIBLE_GROUP, render.HIDDEN_GROUP)
+        self.model.ptr.geom_group[geom_ids] = np.where(visible, VISIBLE_GROUP, mjcf.HIDDEN_GROUP)
 
     def set_object_rgba(self, geom_id: int, rgba) -> None:
         self.model.ptr.geom_rgba[geom_id] = rgba
@@ -193,7 +193,7 @@ def batch_tics(xp, qpos, qvel, forward, turn, turn_held, timestep: float, path, 
         keep = xp.where(stopped > _BLOCKED_SQ, FRICTION * (1.0 - reached), FRICTION)
         qvel[:, :2] *= xp.astype(keep, qvel.dtype)[:, None]
         path[:, tic] = qpos[:, :2]
-    return turn_held, look.walking_bob(xp, vx, vy, timestep)
+    return turn_held, walking_bob(xp, vx, vy, timestep)
 
 
 def tic_motion(xp, vx, vy, yaw, forward, turn, turn_held, timestep: float):
@@ -211,3 +211,14 @@ def tic_motion(xp, vx, vy, yaw, forward, turn, turn_held, timestep: float):
     heading = yaw + yaw_rate * timestep
     thrust = forward * THRUST_PER_TIC / timestep
     return vx + thrust * xp.cos(heading), vy + thrust * xp.sin(heading), yaw_rate, turn_held
+
+
+# Doom's walking bob (P_CalcHeight): min(v^2 / 4, 16) map units, v the speed after the tic's thrust in units
+# per tic. The motion makes it; how it swings the eye and the pistol is mjmaze.look.view_bob's.
+MAX_BOB = 16.0  # map units (Doom's MAXBOB)
+
+
+def walking_bob(xp, vx, vy, timestep: float):
+    """Doom's bob in map units of a tic whose velocity after its thrust is ``(vx, vy)`` (m/s)."""
+    speed_sq = (vx * vx + vy * vy) * (timestep / doom.MAP_UNIT) ** 2  # (map units per tic)^2
+    return rules.at_most(xp, speed_sq / 4, MAX_BOB)

@@ -28,8 +28,8 @@ BACKENDS = ("egl", "osmesa")
 SKIP_DRAW_VARIABLE = "MJMAZE_SKIP_DRAW"
 DEBIAN_PACKAGES = {"egl": "libegl1 libgl1-mesa-dri", "osmesa": "libosmesa6"}
 
-# Geom groups: 0-2 drawn (mjcf.CEILING_GROUP, 2, left out of maps); 3 = collision shapes; 5 = hidden objects.
-HIDDEN_GROUP = 5
+# Geom groups: 0-2 drawn (mjcf.CEILING_GROUP, 2, left out of maps); 3 = collision shapes; 5
+# (mjcf.HIDDEN_GROUP) = hidden objects.
 _VISIBLE_GROUPS = (1, 1, 1, 0, 0, 0)
 
 

@@ -145,19 +145,10 @@ def one_hot(xp, index: Array, n: int) -> Array:
 # damage taken, less one a tic, at most 100) and ``bonus_count`` (6 on a
 # pickup, less one a tic). Within a tic Doom hurts the player by its floor
 # first, then counts both down, then touches items: lava's 8 shows as 7 on its
-# first frame, a pickup's 6 as 6 (both as measured).
+# first frame, a pickup's 6 as 6 (both as measured). The tint they give a frame is
+# mjmaze.look.flash's: the rules know nothing of how it looks.
 BONUS_TICS = 6  # Doom's BONUSADD
 MAX_DAMAGE_COUNT = 100
-DAMAGE_RGB = (255, 0, 0)
-BONUS_RGB = (215, 186, 69)
-# ZDoom's red opacity (of 255) for a damage count: a log scale, capped at 175
-# (the table stops where the cap takes over).
-DAMAGE_TO_ALPHA = (
-    0, 8, 16, 23, 30, 36, 42, 47, 53, 58, 62, 67, 71, 75, 79, 83, 87, 90, 94, 97, 100, 103, 107, 109, 112, 115,
-    118, 120, 123, 125, 128, 130, 133, 135, 137, 139, 141, 143, 145, 147, 149, 151, 153, 155, 157, 159, 160, 162,
-    164, 165, 167, 169, 170, 172, 173, 175,
-)  # the table goes on to 113 -> 237, all above the cap
-MAX_FLASH_ALPHA = 0.5  # ZDoom keeps at least half of the view
 
 
 def at_most(xp, x: Array, bound) -> Array:
@@ -183,20 +174,3 @@ def count_down(xp, count: Array, tics) -> Array:
 def bonus_after_step(xp, bonus_count: Array, pickup_tic: Array, tics: int) -> Array:
     """``bonus_count`` after a step of ``tics`` tics whose last pickup was at tic ``pickup_tic`` (-1: none)."""
     return xp.where(pickup_tic >= 0, BONUS_TICS - (tics - 1 - pickup_tic), count_down(xp, bonus_count, tics))
-
-
-def flash(xp, damage_count: Array, bonus_count: Array) -> tuple[Array, Array]:
-    """``(rgb (B, 3), alpha (B,))``: the tint over each env's view; ``frame * (1 - alpha) + rgb * alpha``.
-
-    ZDoom adds the gold, then the red, as layers (``AddBlend``) and caps the
-    sum's opacity at :data:`MAX_FLASH_ALPHA`.
-    """
-    dev = device(damage_count)
-    table = constant(xp, DAMAGE_TO_ALPHA, xp.float64, dev)
-    red = table[xp.clip(damage_count, max=len(DAMAGE_TO_ALPHA) - 1)] / 255
-    gold = xp.astype(xp.clip(bonus_count * 8, max=128), xp.float64) / 255
-    alpha = gold + (1 - gold) * red
-    gold_share = xp.where(alpha > 0, gold / xp.where(alpha > 0, alpha, 1.0), 0.0)
-    rgb = (gold_share[:, None] * constant(xp, BONUS_RGB, xp.float64, dev)
-           + (1 - gold_share[:, None]) * constant(xp, DAMAGE_RGB, xp.float64, dev))
-    return rgb, xp.clip(alpha, max=MAX_FLASH_ALPHA)

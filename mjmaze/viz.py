@@ -128,7 +128,7 @@ class TopDown:
         entries = [("spawn", SPAWN_COLOUR), ("path", PATH_COLOUR), ("agent", AGENT_COLOUR)]
         model = self.physics.model.ptr
         for obj, geom in zip(self.task.rules.objects, self._object_ids):
-            if model.geom_group[geom] == render.HIDDEN_GROUP:
+            if model.geom_group[geom] == mjcf.HIDDEN_GROUP:
                 continue
             label = re.sub(r"_?\d+$", "", obj.name).replace("_", " ")
             rgba = obj.rgba if geom in self._sprite_ids else model.geom_rgba[geom]  # as the map draws it

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import mjmaze
-from mjmaze import look, rules
+from mjmaze import look
 from mjmaze.tasks import two_colour
 
 from conftest import TURN_LEFT, place
@@ -35,7 +35,7 @@ def step_both(envs, action=TURN_LEFT, xy=None):
 
 
 def tinted(frame, damage, bonus):
-    rgb, alpha = rules.flash(np, np.array([damage]), np.array([bonus]))
+    rgb, alpha = look.flash_tint(np, np.array([damage]), np.array([bonus]))
     return look.tint(np, frame.astype(np.uint8), rgb[0], alpha[0]).astype(int)
 
 
@@ -45,17 +45,17 @@ def counts(env):
 
 def test_the_opacities_are_zdooms():
     # Lava's 8, on its first frame (7): ViZDoom's ceiling turned (46, 0, 13) from (0, 0, 17).
-    rgb, alpha = rules.flash(np, np.array([7, 0, 17, 100]), np.array([0, 6, 0, 0]))
+    rgb, alpha = look.flash_tint(np, np.array([7, 0, 17, 100]), np.array([0, 6, 0, 0]))
     assert alpha * 255 == pytest.approx([47, 48, 90, 0.5 * 255])  # red, gold, a wrong green item, the cap
-    assert rgb[0] == pytest.approx(rules.DAMAGE_RGB) and rgb[1] == pytest.approx(rules.BONUS_RGB)
+    assert rgb[0] == pytest.approx(look.DAMAGE_RGB) and rgb[1] == pytest.approx(look.BONUS_RGB)
     # Both at once: ZDoom lays the gold over the red.
-    rgb, alpha = rules.flash(np, np.array([7]), np.array([6]))
+    rgb, alpha = look.flash_tint(np, np.array([7]), np.array([6]))
     gold, red = 48 / 255, 47 / 255
     assert alpha[0] == pytest.approx(gold + (1 - gold) * red)
-    assert rgb[0] == pytest.approx((gold * np.array(rules.BONUS_RGB) + (1 - gold) * red * np.array(rules.DAMAGE_RGB))
+    assert rgb[0] == pytest.approx((gold * np.array(look.BONUS_RGB) + (1 - gold) * red * np.array(look.DAMAGE_RGB))
                                    / alpha[0])
     frame = np.full((2, 2, 3), (15, 21, 15), dtype=np.uint8)
-    rgb, alpha = rules.flash(np, np.array([7]), np.array([0]))
+    rgb, alpha = look.flash_tint(np, np.array([7]), np.array([0]))
     # ViZDoom's mean frame went from (15, 21, 15) to (58, 16-17, 11): within a level.
     assert look.tint(np, frame, rgb[0], alpha[0])[0, 0].tolist() == pytest.approx([58, 17, 11], abs=1)
 

@@ -15,7 +15,7 @@ import pytest
 
 import mjmaze
 
-from mjmaze import compiled_light, look, mjcf, palette, render, sprites, suite, viz
+from mjmaze import compiled_light, look, mjcf, palette, sprites, suite, viz
 from mjmaze.doom import FIRST_OBSERVATION_TIC
 from mjmaze.group import EnvGroup
 from mjmaze.tasks import base, k_item, labyrinth, two_colour
@@ -400,7 +400,7 @@ def test_maps_and_the_flat_style_show_a_sprite_in_its_mean_colour(scenario):
     top_down = viz.TopDown(env, size=128)
     image = top_down.render()
     shown = [obj for obj, geom in zip(env.task.rules.objects, env.physics.object_ids([o.name for o in env.task.rules.objects]))
-             if obj.sprite is not None and env.physics.model.geom_group[geom] != render.HIDDEN_GROUP]
+             if obj.sprite is not None and env.physics.model.geom_group[geom] != mjcf.HIDDEN_GROUP]
     assert shown
     for obj in shown:  # lying on the floor, face up, in its mean colour
         cx, cy = top_down.to_pixels(env.task.state["object_xy"][0][env.task.rules.objects.index(obj)])
@@ -501,7 +501,7 @@ def test_a_sprite_out_of_view_is_left_out_of_the_render_and_the_frame_is_the_sam
 
     def watching(self, scene, k, row):
         shown = hide(self, scene, k, row)
-        left_out.append(shown is not None and physics.model.geom_group[geom] == render.HIDDEN_GROUP)
+        left_out.append(shown is not None and physics.model.geom_group[geom] == mjcf.HIDDEN_GROUP)
         return shown
 
     monkeypatch.setattr(EnvGroup, "_leave_out_unseen", watching)

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mjmaze import rules, suite
+from mjmaze import look, rules, suite
 
 from conftest import SMALL_SETTINGS
 
@@ -76,6 +76,6 @@ def test_flash_compiles_whole_and_matches_numpy():
     damage = np.array([0, 3, 40, 120, 0], dtype=np.int64)
     bonus = np.array([0, 0, 6, 2, 9], dtype=np.int64)
     tnp = rules.namespace(torch.zeros(1))
-    flash = torch.compile(lambda d, b: rules.flash(tnp, d, b), fullgraph=True, backend="eager")
-    for a, b in zip(rules.flash(np, damage, bonus), flash(torch.as_tensor(damage), torch.as_tensor(bonus))):
+    flash = torch.compile(lambda d, b: look.flash_tint(tnp, d, b), fullgraph=True, backend="eager")
+    for a, b in zip(look.flash_tint(np, damage, bonus), flash(torch.as_tensor(damage), torch.as_tensor(bonus))):
         np.testing.assert_array_equal(a, b.numpy())

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import mjmaze
-from mjmaze import core, look, mjcf, registry, rules, suite
+from mjmaze import core, look, mjcf, registry, suite
 
 from conftest import SMALL_SETTINGS
 
@@ -157,7 +157,7 @@ def test_flashes_tint_every_world_as_the_cpu_task():
         damage = {6: 6, 7: 2}.get(step, 0)
         assert flashed.state["damage_count"].tolist() == [damage, damage], step
         assert info["health"].tolist() == [92 if step < 6 else 84] * 2
-        rgb, alpha = rules.flash(flashed.xp, flashed.state["damage_count"], flashed.state["bonus_count"])
+        rgb, alpha = look.flash_tint(flashed.xp, flashed.state["damage_count"], flashed.state["bonus_count"])
         assert torch.equal(obs, look.tint(flashed.xp, obs_plain, rgb, alpha)), step
         assert torch.equal(obs, obs_plain) == (damage == 0), step
 

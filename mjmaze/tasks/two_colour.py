@@ -18,7 +18,7 @@ Rules
     just picked up absorbs: 17 for a green item, 13 for a red one.
     **Decision**: the released decay and damage, where the paper's spec reads 1
     per agent step and 25 (docs/scenarios.md, "Decisions"); each hit flashes the view red
-    (:func:`mjmaze.rules.flash`), every item gold.
+    (:func:`mjmaze.look.flash_tint`), every item gold.
 Rewards
     +0.01 per tic survived (+0.04 per agent step) and ``correct_item_reward``
     (default +1.0) whenever a correct item raises health (so nothing at full
