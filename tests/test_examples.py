@@ -31,7 +31,10 @@ def test_torchrl_takes_the_gymnasium_id_and_the_dm_control_env():
         env = make()
         check_env_specs(env)
         rollout = env.rollout(20)
-        assert tuple(rollout["pixels"].shape) == (20, 64, 112, 3)
+        assert tuple(rollout["pixels"].shape[1:]) == (64, 112, 3)
+        # 20 random steps, or fewer when they reach an exit first (Labyrinth 5's second maze has its
+        # exit next to the spawn; which maze a rollout plays depends on how many resets came before).
+        assert len(rollout) == 20 or rollout["next", "done"][-1].item()
         env.close()
 
 
