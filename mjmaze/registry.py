@@ -23,8 +23,8 @@ class Scenario:
 
     Attributes:
       name: what :func:`mjmaze.load` takes, e.g. ``"labyrinth"``.
-      task: the scenario's class: a :class:`mjmaze.core.MazeRules` subclass (or, as before,
-        a :class:`mjmaze.tasks.base.MazeTask` subclass).
+      task: the scenario's class: a :class:`mjmaze.core.MazeRules` subclass (its dm_control task is a
+        :class:`mjmaze.tasks.base.MazeTask` holding one).
       gym_id: the gymnasium id, e.g. ``"mjmaze/Labyrinth-v0"`` (the built-in
         scenarios' current ids come from :mod:`mjmaze.versions`).
       seed_code: an integer that enters every maze seed of the scenario. Fixed

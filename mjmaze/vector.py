@@ -126,8 +126,7 @@ class _SharedGroup:
         if seeds is not None:
             for row, key in enumerate(batch.seed_keys([seeds[slot] for slot in self._slots])):
                 group.reseed(row, int(key))
-        self._ended[:] = True
-        self.restart(self._ended)
+        self.restart(np.ones(len(self._rows), dtype=bool))
         self._ended[:] = False
         self._write_outcome(0.0, False, False)
         self.draw()

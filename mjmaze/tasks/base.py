@@ -20,10 +20,10 @@ from dm_env import specs
 
 from mjmaze import configs, core, doom, look, mjcf
 from mjmaze.arena import Arena
-from mjmaze.rules import seed_key
-from mjmaze.group import EnvGroup
 from mjmaze.core import EPISODE_STEPS
+from mjmaze.group import EnvGroup
 from mjmaze.physics import MazePhysics
+from mjmaze.rules import seed_key
 
 
 class MazeTask(base.Task):
