@@ -61,8 +61,7 @@ class Arena:
 
     def __init__(self, rules, view, layouts: Sequence[configs.MazeConfig] | None = None):
         self.objects = tuple(rules.objects)
-        self.room, self.cell_size = rules.room, rules.layout.cell_size
-        self.width, self.height = view.width, view.height
+        self.room, self.cell_size, self.view = rules.room, rules.layout.cell_size, view
         self.layouts = None if layouts is None else list(layouts)
         quads = None if layouts is None else [walls.wall_mesh_quads(c.h_walls, c.v_walls, self.cell_size)
                                               for c in self.layouts]
@@ -80,8 +79,8 @@ class Arena:
         """Makes ``model``, compiled from :attr:`xml`, final (see the module docstring); returns its ids."""
         ids = self.ids(model)
         mjcf.paint_textures(model, self.room, self.cell_size)
-        mjcf.write_sprites(model, [self.objects[k] for k in ids.sprite_objects], ids.sprites, self.width)
-        mjcf.set_ego_projection(model, self.width, self.height)
+        mjcf.write_sprites(model, [self.objects[k] for k in ids.sprite_objects], ids.sprites, self.view.width)
+        mjcf.set_ego_projection(model, self.view.width, self.view.height)
         # The walls' vertices are written in world coordinates: undo the compiler's recentring.
         model.geom_pos[ids.wall_visual] = 0.0
         model.geom_quat[ids.wall_visual] = (1.0, 0.0, 0.0, 0.0)

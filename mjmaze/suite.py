@@ -91,7 +91,8 @@ def _split(name: str, task_kwargs: dict | None) -> tuple[dict, dict, dict]:
 
 def make_task(name: str, task_kwargs: dict | None = None) -> base.MazeTask:
     """The dm_control task of scenario ``name`` (no physics, no rendering yet); checks its arguments."""
-    return base.MazeTask(make_rules(name, task_kwargs), make_view(name, task_kwargs), **_split(name, task_kwargs)[2])
+    rules_kwargs, view_kwargs, own = _split(name, task_kwargs)
+    return base.MazeTask(registry.get(name).task(**rules_kwargs), look.View(**view_kwargs), **own)
 
 
 def make_rules(name: str, task_kwargs: dict | None = None) -> core.MazeRules:
