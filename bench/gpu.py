@@ -25,6 +25,10 @@ its figures then mean nothing. Sections (``--only`` picks some):
   paper     the paper's released agents (paper:labyrinth_9, paper:two_colour_1)
             on their 64 test mazes, twice each, on both backends: the Warp
             backend must score within 10% of the CPU one
+  graph     the Warp step replayed as CUDA graphs (``cuda_graph=True``) beside
+            the step launched from Python, alternating: whether the two play
+            alike (the same seeds and actions: frames, rewards, flags, infos),
+            obs/s with frames at 1,024 .. 8,192 worlds, A2C at 4,096 envs
 
 The released agents come from ``--paper-dir`` (or MJMAZE_PAPER_DIR; the
 machine may be offline). What the machine lacks, from ``--wheels``: docs/warp_backend.md, "Measuring on a GPU".
@@ -55,7 +59,7 @@ GPU_WHEELS = ("mujoco", "mujoco-warp", "warp-lang", "dm-control", "labmaze", "dm
               "docstring-parser", "typeguard", "vizdoom")
 SETTINGS = (("labyrinth", {"size": 9}), ("two_colour", {"complexity": 3}))
 PAPER_AGENTS = ("paper:labyrinth_9", "paper:two_colour_1")
-SECTIONS = ("frames", "env", "cpu", "train", "paper")  # the order they run in: a run cut short keeps the first
+SECTIONS = ("frames", "env", "cpu", "train", "paper", "graph")  # the order they run in: a run cut short keeps the first
 
 
 def wheels() -> list[str]:
@@ -171,6 +175,89 @@ def env_speed(device: str, quick: bool) -> dict:
             print(f"  env    {scenario:<11} {worlds:5d} worlds: {row['render']:10.0f} obs/s rendering, "
                   f"{row['no_render']:10.0f} without, {row['launches']:6.0f} launches a step{memory}", flush=True)
     return results
+
+
+def graph(device: str, quick: bool) -> dict:
+    """The Warp step as CUDA graphs beside the step as launched: the same play, obs/s, A2C (bench/warp.py).
+
+    Runs last by default: a failed replay can leave the process's CUDA context unusable.
+    """
+    if not device.startswith("cuda"):
+        print("  graph  needs a CUDA device: skipped", flush=True)
+        return {"skipped": "needs a CUDA device"}
+    results = {}
+    for part, measure in (("same_play", _graph_same_play), ("speed", _graph_speed), ("train", _graph_training)):
+        try:  # each part's figures kept whatever the next one does
+            results[part] = measure(device, quick)
+        except Exception as error:  # noqa: BLE001
+            results[part] = {"error": f"{type(error).__name__}: {error}", "traceback": traceback.format_exc()}
+            print(f"  graph  {part}: failed: {traceback.format_exc()}", flush=True)
+    return results
+
+
+def _graph_same_play(device: str, quick: bool) -> dict:
+    """Both sides with the same seeds and actions (Labyrinth next-step, Two-colour same-step autoreset):
+    the largest differences of frames, rewards, flags and infos."""
+    import torch
+
+    bench = _sibling("warp")
+    results = {}
+    worlds, steps = (8, 12) if quick else (256, 60)
+    for (scenario, kwargs), mode in zip(SETTINGS, ("next_step", "same_step")):
+        sides = [bench._make(scenario, kwargs, worlds, device, True, cuda_graph=side, autoreset_mode=mode)[0]
+                 for side in (False, True)]
+        for envs in sides:
+            envs.reset(seed=1)  # the graph side's graphs were captured in its warm-up: replayed after a reset
+        generator = torch.Generator(device=device).manual_seed(1)
+        differences = {"obs": 0.0, "reward": 0.0, "flags": 0, "info": 0.0}
+        for _ in range(steps):
+            action = torch.randint(0, sides[0].single_action_space.n, (worlds,), device=device, generator=generator)
+            (obs, reward, terminated, truncated, info), (g_obs, g_reward, g_terminated, g_truncated, g_info) = (
+                envs.step(action) for envs in sides)
+            differences["obs"] = max(differences["obs"], float((obs.float() - g_obs.float()).abs().mean()))
+            differences["reward"] = max(differences["reward"], float((reward - g_reward).abs().max()))
+            differences["flags"] += int((terminated != g_terminated).sum() + (truncated != g_truncated).sum())
+            differences["info"] = max(differences["info"], *(float((info[k].double() - g_info[k].double()).abs().max())
+                                                             for k in info if isinstance(info[k], torch.Tensor)))
+        for envs in sides:
+            envs.close()
+        results[scenario] = differences
+        print(f"  graph  {scenario:<11} {worlds} worlds x {steps} steps ({mode}), graphs against launched: mean "
+              f"frame difference up to {differences['obs']:.3f}, reward {differences['reward']:.2g}, "
+              f"{differences['flags']} flags differ, info {differences['info']:.2g}", flush=True)
+    return results
+
+
+def _graph_speed(device: str, quick: bool) -> dict:
+    """obs/s with frames, the step as graphs and as launched, alternating rounds."""
+    import numpy as np
+
+    bench = _sibling("warp")
+    results = {}
+    worlds_list, seconds, rounds = ((8,), 0.5, 1) if quick else ((1024, 4096, 8192), 3.0, 2)
+    for scenario, kwargs in SETTINGS:
+        for worlds in worlds_list:
+            sides = {side: bench._make(scenario, kwargs, worlds, device, True, cuda_graph=side) for side in (False, True)}
+            rates = {False: [], True: []}
+            for _ in range(rounds):  # alternating, so drift hits both sides alike
+                for side, (envs, actions) in sides.items():
+                    rates[side].append(bench.bench_env(envs, actions, device, seconds))
+            row = {"launched": float(np.median(rates[False])), "graphs": float(np.median(rates[True]))}
+            for envs, _ in sides.values():
+                envs.close()
+            del sides
+            results[f"{scenario}_{worlds}"] = row
+            print(f"  graph  {scenario:<11} {worlds:5d} worlds: {row['graphs']:10.0f} obs/s as graphs, "
+                  f"{row['launched']:10.0f} launched ({row['graphs'] / row['launched']:.2f}x)", flush=True)
+    return results
+
+
+def _graph_training(device: str, quick: bool) -> dict:
+    """A2C obs/s with ``--cuda-graph`` (same-step autoreset, as A2C runs)."""
+    worlds, updates = (8, 3) if quick else (4096, 8)
+    rate = _sibling("warp").bench_training(worlds, device, updates, cuda_graph=True)
+    print(f"  graph  train labyrinth 9 {worlds:5d} envs: {rate:10.0f} obs/s with --cuda-graph", flush=True)
+    return {str(worlds): rate}
 
 
 def training(device: str, quick: bool) -> dict:
@@ -313,7 +400,8 @@ def main() -> None:
     name = torch.cuda.get_device_name(torch.device(device)) if device.startswith("cuda") else "CPU"
     print(f"mjmaze on {name} (device {device}){', quick sizes' if args.quick else ''}", flush=True)
     report = {"device": device, "device_name": name, "quick": args.quick, "sections": {}}
-    runs = {"frames": lambda: frames(device, args.quick), "env": lambda: env_speed(device, args.quick),
+    runs = {"graph": lambda: graph(device, args.quick),
+            "frames": lambda: frames(device, args.quick), "env": lambda: env_speed(device, args.quick),
             "train": lambda: training(device, args.quick), "cpu": lambda: cpu_backend(args.quick),
             "paper": lambda: paper_agents(device, args.quick, args.paper_dir)}
     for section in args.only:

@@ -68,15 +68,17 @@ def _memory_now(device: str) -> float:
         return int(statm.read().split()[1]) * resource.getpagesize() / 2**20
 
 
-def _make(scenario: str, kwargs: dict, worlds: int, device: str, render: bool):
-    envs = MazeBatchEnv(worlds, scenario, device=device, render=render, **kwargs)
+def _make(scenario: str, kwargs: dict, worlds: int, device: str, render: bool, **options):
+    """A ``MazeBatchEnv`` reset and stepped 3 times (``options``: its own arguments, e.g. ``cuda_graph``), and
+    a function giving random actions."""
+    envs = MazeBatchEnv(worlds, scenario, device=device, render=render, **options, **kwargs)
     envs.reset(seed=0)
     generator = torch.Generator(device=device).manual_seed(0)
 
     def actions():
         return torch.randint(0, envs.single_action_space.n, (worlds,), device=device, generator=generator)
 
-    for _ in range(3):  # warm up (and compile on a first run)
+    for _ in range(3):  # warm up (and compile on a first run; a CUDA graph is captured on the third step)
         envs.step(actions())
     return envs, actions
 
@@ -133,14 +135,16 @@ def _memory_probe(scenario: str, kwargs: str, worlds: str, device: str) -> None:
     print(after - before)
 
 
-def bench_training(worlds: int, device: str, updates: int) -> float:
-    """Median obs/s of ``train.a2c --backend warp`` on Labyrinth 9x9 with ``worlds`` envs, 16 steps per update."""
+def bench_training(worlds: int, device: str, updates: int, cuda_graph: bool = False) -> float:
+    """Median obs/s of ``train.a2c --backend warp`` on Labyrinth 9x9 with ``worlds`` envs, 16 steps per update
+    (``cuda_graph``: each env step replayed as one CUDA graph, ``--cuda-graph``)."""
     with tempfile.TemporaryDirectory() as runs:
         total = worlds * 16 * updates
         subprocess.run(
             [sys.executable, "-m", "mjmaze.train.a2c", "--scenario", "labyrinth", "--size", "9", "--backend", "warp",
              "--device", device, "--num-envs", str(worlds), "--num-steps", "16", "--total-steps", str(total),
-             "--runs-dir", runs, "--run-name", "bench", "--checkpoint-every", str(10 * total), "--no-progress"],
+             "--runs-dir", runs, "--run-name", "bench", "--checkpoint-every", str(10 * total), "--no-progress",
+             *(["--cuda-graph"] if cuda_graph else [])],
             check=True,
         )
         lines = (pathlib.Path(runs) / "bench" / "metrics.jsonl").read_text().splitlines()

@@ -72,7 +72,16 @@ class Arena:
 
     def compile(self) -> tuple[mujoco.MjModel, ArenaIds]:
         """A model of the arena, final, and its ids."""
-        model = mujoco.MjModel.from_xml_string(self.xml)
+        try:
+            model = mujoco.MjModel.from_xml_string(self.xml)
+        except ValueError as error:
+            # MuJoCo's XML reader (xml_util.cc, ReadAttrVec) reads errno after parsing a list of numbers,
+            # past allocations that can succeed on a fallback and leave it ENOMEM: "unknown error in
+            # attribute" for valid XML, seen once on a GPU machine (a second process compiled the same
+            # XML). This XML is generated and valid: compile it once more; a real error repeats.
+            if "unknown error in attribute" not in str(error):
+                raise
+            model = mujoco.MjModel.from_xml_string(self.xml)
         return model, self.finish(model)
 
     def finish(self, model: mujoco.MjModel) -> ArenaIds:

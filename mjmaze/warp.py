@@ -32,6 +32,9 @@ imports Warp or torch, only this module does.
 
 from __future__ import annotations
 
+import contextlib
+import functools
+from collections.abc import Callable
 from typing import Any
 
 import mujoco
@@ -50,6 +53,9 @@ _AWAY_Z = -50.0
 # box or a pillar's in up to 4 points (a face's corners), and at most a
 # junction's four wall boxes and a pillar at once.
 _CONTACTS_PER_WORLD = 32
+# Steps a CUDA-graph env runs as they are before capturing one: they load every Warp module and build MuJoCo
+# Warp's renderer kernel (loading or building during a capture would fail).
+_EAGER_STEPS = 2
 
 
 def build_model(task: core.MazeRules, view: look.View) -> tuple[mujoco.MjModel, ArenaIds, np.ndarray, np.ndarray]:
@@ -102,6 +108,12 @@ class MazeBatchEnv(batch.BatchEnv):
         is the CPU, where there is nothing to wait for and the whole batch's
         start would cost most (0.7 s a step for 200 Two-colour worlds); on a GPU
         every scenario restarts under the mask.
+      cuda_graph: on a CUDA device, replay every step as a chain of CUDA
+        graphs captured on its third step (:class:`_StepGraphs`; the first two
+        steps run as they are and load every kernel): ~a dozen graph launches
+        a step instead of ~500 launches from Python. Needs a driver with
+        conditional graph nodes (CUDA 12.4+). Off by default until measured on
+        a GPU (docs/speed.md).
       **task_kwargs: the scenario's task arguments, as for the CPU envs. Env
         ``i`` cycles through the configurations from its own offset, as in
         :class:`mjmaze.vector.MazeVectorEnv`.
@@ -119,6 +131,7 @@ class MazeBatchEnv(batch.BatchEnv):
         render: bool = True,
         render_segmentation: bool = False,
         restart_by_index: bool | None = None,
+        cuda_graph: bool = False,
         **task_kwargs: Any,
     ):
         self._keep_final_obs = bool(keep_final_obs)
@@ -136,6 +149,14 @@ class MazeBatchEnv(batch.BatchEnv):
         if restart_by_index is None:
             restart_by_index = task.costly_start and self.device.type == "cpu"
         self.restart_by_index = bool(restart_by_index)
+        if cuda_graph and self.device.type != "cuda":
+            raise ValueError(f"cuda_graph=True needs a CUDA device; got device={str(device)!r}")
+        if cuda_graph and not wp.is_conditional_graph_supported():
+            raise ValueError("cuda_graph=True needs CUDA graphs with conditional nodes (MuJoCo Warp's solver loop): "
+                             "a CUDA 12.4+ driver and toolkit; pass cuda_graph=False")
+        if cuda_graph and self.restart_by_index:
+            raise ValueError("cuda_graph=True cannot replay restart_by_index=True (it reads the restarting worlds' "
+                             "count back from the device); leave restart_by_index at its default")
         self._wp_device = wp.get_device(str(device))
         self.xp = rules.namespace(torch.zeros(1))
         height, width = view.height, view.width
@@ -190,7 +211,16 @@ class MazeBatchEnv(batch.BatchEnv):
         self._rgb_packed = wp.to_torch(self._render.rgb_data)
         self._depth = wp.to_torch(self._render.depth_data).view(n, height, width) if textured else None
         self._cam_xpos = wp.to_torch(self._data.cam_xpos)
-        self._stream = wp.stream_from_torch(torch.cuda.current_stream(dev)) if dev.type == "cuda" else None
+        # Warp's kernels go on a torch stream: torch's current one, or with a CUDA graph the env's own (a
+        # stream torch made: torch captures only on its own, non-blocking streams).
+        self._graph_stream = torch.cuda.Stream(dev) if cuda_graph else None
+        self._stream = (wp.stream_from_torch(self._graph_stream or torch.cuda.current_stream(dev))
+                        if dev.type == "cuda" else None)
+        self._graphs: _StepGraphs | None = None  # the step's graphs, once captured
+        self._capturing: _StepGraphs | None = None  # the graphs being captured, while they are
+        self._graph_actions = torch.zeros(n, dtype=torch.int64, device=dev)
+        self._graph_outputs: tuple | None = None
+        self._eager_steps = 0
 
         self._seed_keys = torch.zeros(n, dtype=torch.int64, device=dev)
         self._episodes = torch.zeros(n, dtype=torch.int64, device=dev)
@@ -209,12 +239,12 @@ class MazeBatchEnv(batch.BatchEnv):
         n = self.num_envs
         seeds = batch.env_seeds(seed, n)
         keys = np.random.default_rng().integers(1 << 32, size=n) if seeds is None else batch.seed_keys(seeds)
-        self._seed_keys.copy_(torch.as_tensor(keys, dtype=torch.int64))
-        self._episodes.zero_()
-        with self._warp_stream():
+        with self._streams():
+            self._seed_keys.copy_(torch.as_tensor(keys, dtype=torch.int64))
+            self._episodes.zero_()
             self._start_episodes(torch.ones(n, dtype=torch.bool, device=self.device))
             self._show_state()
-        self._ended.zero_()
+            self._ended.zero_()
         return self._obs.clone(), self._infos()
 
     def step(self, actions):
@@ -232,19 +262,69 @@ class MazeBatchEnv(batch.BatchEnv):
         else:
             actions = batch.check_actions(actions, self.num_envs, self.single_action_space.n)
         actions = torch.as_tensor(actions, device=self.device).long()
-        with self._warp_stream():
-            reward, terminated, truncated, self._ended, final = batch.autoreset_step(
-                self.xp, self, actions, self._ended, self.same_step)
+        if self.state is None:
+            raise RuntimeError("call reset() before step()")
+        if self._graph_stream is None:
+            with self._streams():
+                reward, terminated, truncated, infos = self._step_in_place(actions)
+            return self._obs.clone(), reward, terminated, truncated, infos
+        actions.record_stream(self._graph_stream)  # read on the env's stream: kept until it has been
+        with self._streams():
+            self._graph_actions.copy_(actions)
+            if self._graphs is None and self._eager_steps < _EAGER_STEPS:
+                self._eager_steps += 1
+                outputs = self._step_in_place(self._graph_actions)
+            else:
+                if self._graphs is None:
+                    self._capture_step()
+                self._graphs.replay()
+                outputs = self._graph_outputs
+        # Copies on the caller's stream: a graph's outputs are overwritten by its next replay.
+        return (self._obs.clone(), *_copies(outputs))
+
+    def _step_in_place(self, actions: torch.Tensor) -> tuple:
+        """A step of every env (:func:`mjmaze.batch.autoreset_step`): ``(reward, terminated, truncated, infos)``.
+
+        What it carries over to the next step (the rule state, the poses, the
+        arena, the frames) it writes into the same tensors every time, so that
+        a CUDA graph captured from one call replays it.
+        """
+        reward, terminated, truncated, ended, final = batch.autoreset_step(
+            self.xp, self, actions, self._ended, self.same_step)
+        self._ended.copy_(ended)
         infos = self._infos()
         infos.update(final or {})
-        return self._obs.clone(), reward.float(), terminated, truncated, infos
+        return reward.float(), terminated, truncated, infos
+
+    def _capture_step(self) -> None:
+        """Captures :meth:`_step_in_place` of :attr:`_graph_actions` as :class:`_StepGraphs` (capturing runs nothing)."""
+        torch.cuda.synchronize(self.device)
+        graphs = self._capturing = _StepGraphs(self._stream)
+        try:
+            self._graph_outputs = graphs.capture(lambda: self._step_in_place(self._graph_actions))
+        except Exception as error:
+            raise RuntimeError(f"cuda_graph=True: capturing the step failed ({type(error).__name__}: {error}); "
+                               "nothing was stepped: make the env with cuda_graph=False") from error
+        finally:
+            self._capturing = None
+        self._graphs = graphs
+
+    def _run_warp(self, calls: Callable[[], None]) -> None:
+        """Runs a run of MuJoCo Warp's calls; while the step is being captured, as a Warp graph of its own."""
+        if self._capturing is None:
+            calls()
+        else:
+            self._capturing.warp(calls)
 
     # -- the steps of batch.autoreset_step (every env, masks: no host reads) ---
 
     def simulate(self, actions: torch.Tensor, playing: torch.Tensor | None) -> tuple:
         """Every env's tics and rules (an env not ``playing`` restarts now: its outcome is masked out)."""
         self._advance_physics(self._actions[actions, 0], self._actions[actions, 1])
-        return self.task.step_state(self.xp, self.state, self._path)
+        state = dict(self.state)
+        outcome = self.task.step_state(self.xp, state, self._path)
+        self._keep_state(state)
+        return outcome
 
     def keep_final(self, ended: torch.Tensor) -> dict:
         """``final_info`` (and ``final_obs``) of the envs that just ended, before they are reset.
@@ -267,21 +347,37 @@ class MazeBatchEnv(batch.BatchEnv):
 
     def close_extras(self, **kwargs: Any) -> None:
         self.state = None
+        self._graphs = self._graph_outputs = None
 
     # -- what the env does per step ------------------------------------------
 
-    def _warp_stream(self):
-        """Warp kernels go on torch's current stream: no synchronisation between the two."""
-        if self._stream is None:
-            return wp.ScopedDevice(self._wp_device)
-        return wp.ScopedStream(self._stream)
+    @contextlib.contextmanager
+    def _streams(self):
+        """Runs the env's work on its stream: Warp's kernels on a torch stream, no synchronisation between the two.
+
+        Without a CUDA graph that is torch's current stream. With one it is the
+        env's own: it waits for the caller's stream (the actions) on entry, and
+        the caller's stream waits for it (the outputs) on exit.
+        """
+        if self._graph_stream is None:
+            with wp.ScopedStream(self._stream) if self._stream is not None else wp.ScopedDevice(self._wp_device):
+                yield
+            return
+        caller = torch.cuda.current_stream(self.device)
+        self._graph_stream.wait_stream(caller)
+        # Warp's stream first: entering it synchronises with the stream before.
+        with wp.ScopedStream(self._stream), torch.cuda.stream(self._graph_stream):
+            yield
+        caller.wait_stream(self._graph_stream)
 
     def _advance_physics(self, forward: torch.Tensor, turn: torch.Tensor) -> None:
         """The step's tics with Doom's motion and speculative contacts (:func:`mjmaze.physics.batch_tics`)."""
-        self._turn_held, self._bob = physics.batch_tics(
+        turn_held, bob = physics.batch_tics(
             self.xp, self._qpos, self._qvel, forward, turn, self._turn_held, self._timestep, self._path,
-            step_contacts=lambda: mjw.step(self._model, self._data),
+            step_contacts=lambda: self._run_warp(functools.partial(mjw.step, self._model, self._data)),
         )
+        self._turn_held.copy_(turn_held)
+        self._bob.copy_(bob)
 
     def _start_episodes(self, restart: torch.Tensor) -> None:
         """New episodes where ``restart`` ``(N,)`` is set: configuration, the scenario's start, the arena.
@@ -306,28 +402,50 @@ class MazeBatchEnv(batch.BatchEnv):
         keys = task.episode_keys(xp, self._seed_keys[envs], episodes)
         config_index = task.config_indices(xp, keys, episodes, first=self._first[envs])
         start = task.start_state(xp, {name: value[config_index] for name, value in self._config_table.items()}, keys)
-        if self.state is None:
-            self.state = start
+        if self.state is None:  # the first reset: the tensors every later step writes into
+            self.state = {name: value.clone() for name, value in start.items()}
         elif isinstance(envs, slice):  # every env worked out: the start where ``restart`` is set
-            self.state = {name: _where_rows(restart, value, self.state[name]) for name, value in start.items()}
+            self._keep_state({name: _where_rows(restart, value, self.state[name]) for name, value in start.items()})
         else:  # the restarting envs alone: their rows
-            self.state = {name: _scatter_rows(self.state[name], envs, value) for name, value in start.items()}
+            for name, value in start.items():
+                self.state[name][envs] = value
             config_index = _scatter_rows(self._config_index, envs, config_index)
         self._start_arena(self.state, config_index, restart)
+
+    def _keep_state(self, state: dict) -> None:
+        """Writes a step's new rule state into :attr:`state`'s tensors, in place.
+
+        The rules return new tensors; a step keeps every value it carries over
+        to the next one in the same memory, so that a CUDA graph of the step
+        (``cuda_graph``), which replays the same addresses, reads it there.
+        """
+        if state.keys() != self.state.keys():
+            raise RuntimeError(f"the rules changed the state's fields: {sorted(set(state) ^ set(self.state))}")
+        kept = {id(tensor) for tensor in self.state.values()}
+        new = {}
+        for name, value in state.items():
+            kept_value = self.state[name]
+            if value.shape != kept_value.shape or value.dtype != kept_value.dtype:
+                raise RuntimeError(f"the rules changed state[{name!r}] from {kept_value.dtype} {tuple(kept_value.shape)} "
+                                   f"to {value.dtype} {tuple(value.shape)}")
+            # A field given another field's kept tensor is copied before that one is overwritten.
+            new[name] = value.clone() if id(value) in kept and value is not kept_value else value
+        for name, value in new.items():
+            self.state[name].copy_(value)
 
     def _start_arena(self, start: dict, config_index: torch.Tensor, restart: torch.Tensor) -> None:
         """Puts every env where ``restart`` is set at its start: agent, maze, object colours.
 
         ``start`` and ``config_index`` hold a row for every env; only the restarting ones are read.
         """
-        self._episodes = self._episodes + restart.long()
-        self._config_index = torch.where(restart, config_index, self._config_index)
+        self._episodes.add_(restart.long())
+        self._config_index.copy_(torch.where(restart, config_index, self._config_index))
         rows = restart[:, None]
         self._qpos[:, 0:3] = torch.where(rows, start["pose"].float(), self._qpos[:, 0:3])
         self._qvel.mul_(~rows)
         self._warmstart.mul_(~rows)
-        self._turn_held = torch.where(restart, 0.0, self._turn_held)
-        self._bob = torch.where(restart, 0.0, self._bob)
+        self._turn_held.masked_fill_(restart, 0.0)
+        self._bob.masked_fill_(restart, 0.0)
         # The maze: its wall boxes, its wall mesh (Warp reads these arrays in place).
         box_z = self._geom_pos[:, self._box_ids, 2]
         self._geom_pos[:, self._box_ids, 2] = torch.where(rows, self._box_z[config_index], box_z)
@@ -355,7 +473,6 @@ class MazeBatchEnv(batch.BatchEnv):
         self._place_objects(self.state)
         if not self._rendering:
             return
-        m, d, rc = self._model, self._data, self._render
         sprite_xy = self._geom_pos[:, self._sprite_ids, 0:2] if len(self._sprite_ids) else None
         scene = self._pipeline.scene(self.state, self._qpos[:, 0:2], self._qpos[:, 2], self._bob, sprite_xy)
         if self.view.head_bob:
@@ -363,16 +480,21 @@ class MazeBatchEnv(batch.BatchEnv):
         if len(self._sprite_ids):  # Doom's sprites: facing the camera, at their animation frame and depth
             self._geom_matid[:, self._sprite_ids] = scene["sprite_material"].int()
             self._geom_quat[:, self._sprite_ids] = scene["sprite_quat"][:, None, :].float()
+        self._run_warp(self._draw_scene)
+        # Packed 0xAARRGGBB per pixel (MuJoCo Warp's pack_rgba_to_uint32): bytes B, G, R, A in memory.
+        packed = self._rgb_packed.view(torch.uint8).view(self.num_envs, self.view.height, self.view.width, 4)
+        inverse_depth = 1 / self._depth if self._depth is not None else None
+        # Doom's light and what Doom draws over the scene, as on the CPU (mjmaze.look).
+        self._obs.copy_(self._pipeline.finish(packed[..., :3].flip(-1), inverse_depth, self._cam_xpos[:, self._camera],
+                                              self._qpos[:, 2], self.state, scene))
+
+    def _draw_scene(self) -> None:
+        """MuJoCo Warp's part of the frames: every world's geoms placed and lit, its scene ray-traced."""
+        m, d, rc = self._model, self._data, self._render
         mjw.kinematics(m, d)  # positions lag a step behind mjw.step's integration
         mjw.camlight(m, d)
         mjw.refit_bvh(m, d, rc)
         mjw.render(m, d, rc)
-        # Packed 0xAABBGGRR per pixel: bytes R, G, B, A in memory.
-        packed = self._rgb_packed.view(torch.uint8).view(self.num_envs, self.view.height, self.view.width, 4)
-        inverse_depth = 1 / self._depth if self._depth is not None else None
-        # Doom's light and what Doom draws over the scene, as on the CPU (mjmaze.look).
-        self._obs.copy_(self._pipeline.finish(packed[..., [2, 1, 0]], inverse_depth, self._cam_xpos[:, self._camera],
-                                              self._qpos[:, 2], self.state, scene))
 
     def segmentation(self) -> torch.Tensor:
         """``(N, H, W)`` geom id drawn at each pixel of the last frames, -1 for none (needs ``render_segmentation``)."""
@@ -394,6 +516,73 @@ class MazeBatchEnv(batch.BatchEnv):
 
     def __repr__(self) -> str:
         return f"MazeBatchEnv({self.scenario!r}, num_envs={self.num_envs}, device={str(self.device)!r})"
+
+
+class _StepGraphs:
+    """One env step as a chain of CUDA graphs, captured once and replayed in the order captured.
+
+    torch's ops between MuJoCo Warp's calls go into torch graphs that share
+    one memory pool (safe when replayed in the order captured: torch's "graph
+    memory management"); each run of MuJoCo Warp's calls into a Warp graph of
+    its own, as MuJoCo Warp's benchmarks capture its step (the solver's loop
+    a conditional node). Neither library captures into the other's graph:
+    torch keeps a graph's tensors in its pool only within a capture it began,
+    and Warp ends and restarts a capture around each conditional node.
+    """
+
+    def __init__(self, stream: wp.Stream):
+        self._stream = stream
+        self._pool = torch.cuda.graph_pool_handle()
+        self._parts: list[torch.cuda.CUDAGraph | wp.Graph] = []
+        self._torch: torch.cuda.CUDAGraph | None = None
+
+    def capture(self, step: Callable[[], Any]) -> Any:
+        """Captures ``step()`` (run on torch's current stream, Warp's calls through :meth:`warp`); returns
+        its outputs, which every :meth:`replay` overwrites."""
+        self._begin_torch()
+        try:
+            outputs = step()
+        except BaseException:
+            with contextlib.suppress(Exception):  # the step's own error is the one to see
+                self._end_torch()
+            raise
+        self._end_torch()
+        return outputs
+
+    def warp(self, calls: Callable[[], None]) -> None:
+        """Captures ``calls()`` (MuJoCo Warp's, no torch op) as a Warp graph between two torch graphs."""
+        self._end_torch()
+        with wp.ScopedCapture(stream=self._stream, force_module_load=False) as capture:
+            calls()
+        self._parts.append(capture.graph)
+        self._begin_torch()
+
+    def replay(self) -> None:
+        """Launches the step's graphs in order on the env's stream."""
+        for part in self._parts:
+            if isinstance(part, torch.cuda.CUDAGraph):
+                part.replay()
+            else:
+                wp.capture_launch(part, stream=self._stream)
+
+    def _begin_torch(self) -> None:
+        self._torch = torch.cuda.CUDAGraph()
+        self._torch.capture_begin(pool=self._pool, capture_error_mode="thread_local")
+
+    def _end_torch(self) -> None:
+        if self._torch is not None:
+            graph, self._torch = self._torch, None
+            graph.capture_end()
+            self._parts.append(graph)
+
+
+def _copies(outputs):
+    """Copies of a step's output tensors (in tuples and dicts, ``final_info`` nested)."""
+    if isinstance(outputs, dict):
+        return {name: _copies(value) for name, value in outputs.items()}
+    if isinstance(outputs, tuple):
+        return tuple(_copies(value) for value in outputs)
+    return outputs.clone()
 
 
 def _where_rows(rows: torch.Tensor, new: torch.Tensor, old: torch.Tensor) -> torch.Tensor:

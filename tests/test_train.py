@@ -182,6 +182,7 @@ def test_a_run_from_before_head_bob_and_flashes_resumes_and_plays_only_without_t
     (["--total-steps", "-5"], "--total-steps must be at least 1"),
     (["--lr", "0"], "--lr must be positive"),
     (["--backend", "tpu"], "--backend must be cpu or warp"),
+    (["--cuda-graph"], "--cuda-graph replays the Warp backend's steps: pass it with --backend warp"),
     (["--device", "gpu0"], "--device 'gpu0' is not a device: use auto, cpu or cuda"),
     (["--size", "6"], "size must be one of"),
 ])

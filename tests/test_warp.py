@@ -14,6 +14,7 @@ import gymnasium
 import mujoco
 import numpy as np
 import pytest
+from torch.overrides import TorchFunctionMode
 
 import mjmaze
 from mjmaze import core, look, mjcf, registry, suite
@@ -201,38 +202,86 @@ def test_next_step_autoreset_ignores_the_action_after_the_end():
     assert int(info["step"][1]) == 0 and int(info["step"][0]) == 2
 
 
-@contextlib.contextmanager
-def _no_reads_from_the_device(monkeypatch):
-    """Fails on anything that makes the host wait for a GPU's results: a tensor's value read back in Python,
-    ``nonzero`` (its size is the data's), a Python loop or branch over a tensor."""
-    def refuse(*args, **kwargs):
-        raise AssertionError("a value was read back from the device")
+class _DeviceWorkOnly(TorchFunctionMode):
+    """Fails on what a step on a GPU must not do, so that it never waits and a CUDA graph can replay it:
+    read a tensor's value back in Python (a branch or loop over a tensor, ``item``, ``nonzero``, whose size
+    is the data's) or copy Python data onto the device (``torch.tensor``, indexing with a list)."""
 
-    with monkeypatch.context() as patch:
-        for name in ("__bool__", "__int__", "__float__", "__index__", "item", "tolist", "nonzero"):
-            patch.setattr(torch.Tensor, name, refuse)
-        patch.setattr(torch, "nonzero", refuse)
-        yield
+    READS = {"__bool__", "__int__", "__float__", "__index__", "item", "tolist", "nonzero", "masked_select"}
+    COPIES = {"tensor", "as_tensor", "asarray", "new_tensor"}
+
+    def __torch_function__(self, func, types, args=(), kwargs=None):
+        name = getattr(func, "__name__", "")
+        if name in self.READS:
+            raise AssertionError(f"a value was read back from the device ({name})")
+        if name in self.COPIES or (name in ("__getitem__", "__setitem__") and _python_index(args[1])):
+            raise AssertionError(f"Python data was copied onto the device ({name})")
+        return func(*args, **(kwargs or {}))
+
+
+def _python_index(index) -> bool:
+    """Whether an index holds a list or a numpy array (copied onto the device to index a tensor there)."""
+    parts = index if isinstance(index, tuple) else (index,)
+    return any(isinstance(part, (list, np.ndarray)) for part in parts)
+
+
+class _NoTorch(TorchFunctionMode):
+    """Fails on any torch op (inside MuJoCo Warp's calls, which ``cuda_graph`` captures as Warp graphs)."""
+
+    def __torch_function__(self, func, types, args=(), kwargs=None):
+        raise AssertionError(f"a torch op ({getattr(func, '__name__', func)}) ran among MuJoCo Warp's calls")
 
 
 @pytest.mark.parametrize("scenario", list(SETTINGS))
 @pytest.mark.parametrize("mode", ["next_step", "same_step"])
-def test_a_step_never_waits_for_the_device(scenario, mode, monkeypatch):
-    # As on a GPU: every world's start under the mask, even a costly one (on the CPU, by default, by index).
+def test_a_step_can_be_captured_as_cuda_graphs(scenario, mode, monkeypatch):
+    # What cuda_graph=True needs of a step (MazeBatchEnv._StepGraphs), checked on the CPU: device work only, and
+    # every Warp launch in a run of MuJoCo Warp's calls (a Warp graph) with no torch op among them.
     batch = mjwarp.MazeBatchEnv(3, scenario, device="cpu", autoreset_mode=mode, restart_by_index=False, **SETTINGS[scenario])
-    assert batch.restart_by_index is False
+    assert batch.restart_by_index is False  # as on a GPU: every world's start under the mask
     batch.reset(seed=SEED)
     actions = torch.tensor([2, 0, 1])
+    batch.step(actions)  # a CUDA graph's warm-up: the step's constants made once
+    step_in_place, run_warp = batch._step_in_place, batch._run_warp
+    launches = {"in Warp's runs": 0, "elsewhere": 0}
+    in_warp = False
+
+    def guarded_step(actions):
+        with _DeviceWorkOnly():
+            return step_in_place(actions)
+
+    def guarded_warp(calls):
+        nonlocal in_warp
+        in_warp = True
+        try:
+            with _NoTorch():
+                run_warp(calls)
+        finally:
+            in_warp = False
+
+    def counted(launch):
+        def counting(*args, **kwargs):
+            launches["in Warp's runs" if in_warp else "elsewhere"] += 1
+            return launch(*args, **kwargs)
+        return counting
+
+    batch._step_in_place, batch._run_warp = guarded_step, guarded_warp
+    for name in ("launch", "launch_tiled"):  # MuJoCo Warp calls them by attribute
+        monkeypatch.setattr(mjwarp.wp, name, counted(getattr(mjwarp.wp, name)))
     ends = 0
     for step in range(6):
         if step % 2 == 0:  # env 0's episode runs out of time on this step: it restarts
             batch.state["steps"][0] = core.EPISODE_STEPS - 1
-        with _no_reads_from_the_device(monkeypatch):
-            _, _, terminated, truncated, _ = batch.step(actions)
+        _, _, terminated, truncated, _ = batch.step(actions)
         ends += int((terminated | truncated).sum())
     assert ends >= 2
-    with pytest.raises(AssertionError, match="read back"), _no_reads_from_the_device(monkeypatch):
-        bool(terminated.any())  # the guard does catch a read
+    assert launches["elsewhere"] == 0 and launches["in Warp's runs"] > 6 * 4  # a mujoco_warp.step a tic at least
+    with pytest.raises(AssertionError, match="read back"), _DeviceWorkOnly():
+        bool(terminated.any())  # the guards do catch a read,
+    with pytest.raises(AssertionError, match="copied onto"), _DeviceWorkOnly():
+        batch._obs[..., [2, 1, 0]]  # an index sent from the host,
+    with pytest.raises(AssertionError, match="torch op"):
+        guarded_warp(lambda: batch._obs.float())  # and torch among Warp's calls
 
 
 @pytest.mark.parametrize("by_index", [False, True])
@@ -290,6 +339,10 @@ def test_bad_arguments_say_what_to_do():
         mjwarp.MazeBatchEnv(2, "labyrinth", device="cpu", autoreset_mode="never")
     with pytest.raises(ValueError, match="size"):
         mjwarp.MazeBatchEnv(2, "labyrinth", device="cpu", size=6)
+    with pytest.raises(ValueError, match="cuda_graph=True needs a CUDA device"):
+        mjwarp.MazeBatchEnv(2, "labyrinth", device="cpu", cuda_graph=True)
+    with pytest.raises(RuntimeError, match=r"call reset\(\) before step\(\)"):
+        mjwarp.MazeBatchEnv(2, "labyrinth", device="cpu", render=False, size=5).step([0, 0])
 
 
 # Random episodes from each side, the same seeds and actions: Warp's float32

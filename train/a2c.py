@@ -103,7 +103,7 @@ def train(args: Args) -> pathlib.Path:
     torch.manual_seed(args.seed)
     if args.backend == "warp":
         # The envs live on the network's device: observations never leave it.
-        options = dict(device=str(device), keep_final_obs=False)
+        options = dict(device=str(device), keep_final_obs=False, cuda_graph=args.cuda_graph)
     else:
         options = dict(num_workers=args.num_workers, copy=False)
     make_envs = functools.partial(

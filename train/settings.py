@@ -56,6 +56,8 @@ class _RunSettings:
     """Doom's full-screen flashes (red when hurt, gold on a pickup); --no-flashes leaves the view untinted"""
     backend: str = "cpu"
     """where the envs run: cpu (worker processes) or warp (every env in one MuJoCo Warp model on --device, beside the network; pip install "mjmaze[warp]")"""
+    cuda_graph: bool = False
+    """with --backend warp on a GPU: replay each env step as one CUDA graph (mjmaze.warp.MazeBatchEnv's cuda_graph)"""
     torch_threads: int | None = None
     """CPU threads for the network's update (None: PyTorch's default); on CPU the rollout uses one"""
     run_name: str | None = None
@@ -104,6 +106,8 @@ class _RunSettings:
             raise ValueError(f"--gamma must lie in [0, 1], got {self.gamma}")
         if self.backend not in ("cpu", "warp"):
             raise ValueError(f"--backend must be cpu or warp, got {self.backend!r}")
+        if self.cuda_graph and self.backend != "warp":
+            raise ValueError("--cuda-graph replays the Warp backend's steps: pass it with --backend warp")
         pick_device(self.device)
         suite.make_task(self.scenario, self.task_kwargs())  # the scenario checks its own arguments
 

@@ -14,6 +14,7 @@ import collections
 import math
 
 import numpy as np
+from dm_control.mujoco import wrapper
 from dm_control.rl import control
 from dm_control.suite import base
 from dm_env import specs
@@ -165,8 +166,9 @@ def make_physics(rules: core.MazeRules, view: look.View, count: int = 1) -> list
     arena = Arena(rules, view)
     made = []
     for _ in range(count):
-        physics = MazePhysics.from_xml_string(arena.xml)
-        physics.arena = arena.finish(physics.model.ptr)
+        model, ids = arena.compile()
+        physics = MazePhysics.from_model(wrapper.MjModel(model))
+        physics.arena = ids
         made.append(physics)
     return made
 
