@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import gc
 from collections.abc import Callable
 from typing import Any
 
@@ -154,6 +155,9 @@ class MazeBatchEnv(batch.BatchEnv):
         if cuda_graph and not wp.is_conditional_graph_supported():
             raise ValueError("cuda_graph=True needs CUDA graphs with conditional nodes (MuJoCo Warp's solver loop): "
                              "a CUDA 12.4+ driver and toolkit; pass cuda_graph=False")
+        if cuda_graph and not wp.is_mempool_enabled(self._wp_device):
+            raise ValueError("cuda_graph=True needs Warp's memory pool on the device (MuJoCo Warp allocates inside "
+                             "a step): leave wp.set_mempool_enabled alone, or pass cuda_graph=False")
         if cuda_graph and self.restart_by_index:
             raise ValueError("cuda_graph=True cannot replay restart_by_index=True (it reads the restarting worlds' "
                              "count back from the device); leave restart_by_index at its default")
@@ -220,6 +224,7 @@ class MazeBatchEnv(batch.BatchEnv):
         self._capturing: _StepGraphs | None = None  # the graphs being captured, while they are
         self._graph_actions = torch.zeros(n, dtype=torch.int64, device=dev)
         self._graph_outputs: tuple | None = None
+        self._graph_error: RuntimeError | None = None  # why capturing failed, once it has
         self._eager_steps = 0
 
         self._seed_keys = torch.zeros(n, dtype=torch.int64, device=dev)
@@ -268,7 +273,8 @@ class MazeBatchEnv(batch.BatchEnv):
             with self._streams():
                 reward, terminated, truncated, infos = self._step_in_place(actions)
             return self._obs.clone(), reward, terminated, truncated, infos
-        actions.record_stream(self._graph_stream)  # read on the env's stream: kept until it has been
+        if self._graph_error is not None:
+            raise self._graph_error
         with self._streams():
             self._graph_actions.copy_(actions)
             if self._graphs is None and self._eager_steps < _EAGER_STEPS:
@@ -297,16 +303,28 @@ class MazeBatchEnv(batch.BatchEnv):
         return reward.float(), terminated, truncated, infos
 
     def _capture_step(self) -> None:
-        """Captures :meth:`_step_in_place` of :attr:`_graph_actions` as :class:`_StepGraphs` (capturing runs nothing)."""
+        """Captures :meth:`_step_in_place` of :attr:`_graph_actions` as :class:`_StepGraphs` (capturing runs nothing).
+
+        Python's cyclic garbage collector is held off meanwhile: a tensor or a
+        Warp array it freed would be freed on a stream one library captures
+        unknown to the other. A failed capture is raised on every later step.
+        """
         torch.cuda.synchronize(self.device)
-        graphs = self._capturing = _StepGraphs(self._stream)
+        gc.collect()
+        collecting = gc.isenabled()
+        gc.disable()
+        graphs = self._capturing = _StepGraphs(self._stream, self.device)
         try:
             self._graph_outputs = graphs.capture(lambda: self._step_in_place(self._graph_actions))
         except Exception as error:
-            raise RuntimeError(f"cuda_graph=True: capturing the step failed ({type(error).__name__}: {error}); "
-                               "nothing was stepped: make the env with cuda_graph=False") from error
+            self._graph_error = RuntimeError(
+                f"cuda_graph=True: capturing the step failed ({type(error).__name__}: {error}); this env stepped no "
+                "further: make a new one with cuda_graph=False")
+            raise self._graph_error from error
         finally:
             self._capturing = None
+            if collecting:
+                gc.enable()
         self._graphs = graphs
 
     def _run_warp(self, calls: Callable[[], None]) -> None:
@@ -365,10 +383,12 @@ class MazeBatchEnv(batch.BatchEnv):
             return
         caller = torch.cuda.current_stream(self.device)
         self._graph_stream.wait_stream(caller)
-        # Warp's stream first: entering it synchronises with the stream before.
-        with wp.ScopedStream(self._stream), torch.cuda.stream(self._graph_stream):
-            yield
-        caller.wait_stream(self._graph_stream)
+        try:
+            # Warp's stream first: entering it synchronises with the stream before.
+            with wp.ScopedStream(self._stream), torch.cuda.stream(self._graph_stream):
+                yield
+        finally:
+            caller.wait_stream(self._graph_stream)
 
     def _advance_physics(self, forward: torch.Tensor, turn: torch.Tensor) -> None:
         """The step's tics with Doom's motion and speculative contacts (:func:`mjmaze.physics.batch_tics`)."""
@@ -530,8 +550,8 @@ class _StepGraphs:
     and Warp ends and restarts a capture around each conditional node.
     """
 
-    def __init__(self, stream: wp.Stream):
-        self._stream = stream
+    def __init__(self, stream: wp.Stream, device: torch.device):
+        self._stream, self._device = stream, device
         self._pool = torch.cuda.graph_pool_handle()
         self._parts: list[torch.cuda.CUDAGraph | wp.Graph] = []
         self._torch: torch.cuda.CUDAGraph | None = None
@@ -543,8 +563,7 @@ class _StepGraphs:
         try:
             outputs = step()
         except BaseException:
-            with contextlib.suppress(Exception):  # the step's own error is the one to see
-                self._end_torch()
+            self._abandon()
             raise
         self._end_torch()
         return outputs
@@ -575,14 +594,36 @@ class _StepGraphs:
             graph.capture_end()
             self._parts.append(graph)
 
+    def _abandon(self) -> None:
+        """After a failed capture: ends what is still capturing (best effort: the step's own error is the one
+        to see), so that torch's allocator and Warp serve the process as before."""
+        if self._torch is not None:
+            graph, self._torch = self._torch, None
+            try:
+                graph.capture_end()
+            except Exception:  # noqa: BLE001
+                # torch's capture_end failed before giving the allocator back: stop sending allocations to
+                # the graph's pool (torch.cuda.memory's own call for it).
+                index = self._device.index if self._device.index is not None else torch.cuda.current_device()
+                with contextlib.suppress(Exception):
+                    torch._C._cuda_endAllocateToPool(index, self._pool)
+        if self._stream.is_capturing:
+            with contextlib.suppress(Exception):
+                wp.capture_end(stream=self._stream)
+        self._parts.clear()
 
-def _copies(outputs):
-    """Copies of a step's output tensors (in tuples and dicts, ``final_info`` nested)."""
+
+def _copies(outputs, made: dict | None = None):
+    """Copies of a step's output tensors (in tuples and dicts, ``final_info`` nested), one per tensor: the
+    ``_field`` masks that share a tensor share its copy."""
+    made = {} if made is None else made
     if isinstance(outputs, dict):
-        return {name: _copies(value) for name, value in outputs.items()}
+        return {name: _copies(value, made) for name, value in outputs.items()}
     if isinstance(outputs, tuple):
-        return tuple(_copies(value) for value in outputs)
-    return outputs.clone()
+        return tuple(_copies(value, made) for value in outputs)
+    if id(outputs) not in made:
+        made[id(outputs)] = outputs.clone()
+    return made[id(outputs)]
 
 
 def _where_rows(rows: torch.Tensor, new: torch.Tensor, old: torch.Tensor) -> torch.Tensor:
