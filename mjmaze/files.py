@@ -14,6 +14,11 @@ import tempfile
 from collections.abc import Callable
 
 
+def cache_dir() -> pathlib.Path:
+    """Where mjmaze keeps what it downloads: ``$XDG_CACHE_HOME/mjmaze`` (``~/.cache/mjmaze``)."""
+    return pathlib.Path(os.environ.get("XDG_CACHE_HOME") or pathlib.Path.home() / ".cache") / "mjmaze"
+
+
 def _readable(tmp: str) -> None:
     """mkstemp makes owner-only files; give the result the usual permissions."""
     umask = os.umask(0)

@@ -59,6 +59,12 @@ def paper_metric(name: str) -> tuple[str, float, str]:
     return scenario.metric, scenario.metric_scale, scenario.metric_units
 
 
+def default_difficulty(name: str) -> int:
+    """The difficulty scenario ``name``'s rules take when given none (its ``size``, ``num_items``, ...)."""
+    scenario = registry.get(name)
+    return inspect.signature(scenario.task.__init__).parameters[scenario.difficulty].default
+
+
 def _parameters(function, skip=("self", "kwargs", "difficulty", "layout")) -> tuple[str, ...]:
     return tuple(p for p in inspect.signature(function).parameters if p not in skip)
 

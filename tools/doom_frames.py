@@ -42,7 +42,7 @@ import imageio.v3 as iio
 import numpy as np
 
 import mjmaze
-from mjmaze import configs, look, maze, mjcf, palette, sprites, suite, walls
+from mjmaze import configs, look, maze, mjcf, palette, sprites, suite, vizdoom_env, walls
 from mjmaze.tasks import base, find_return, k_item, two_colour
 
 #: The game data ViZDoom draws with (``--freedoom``): None, the installed ViZDoom's own.
@@ -662,9 +662,10 @@ def main() -> None:
                         help="the game data: vizdoom (default: ViZDoom's own), paper (Freedoom 0.10.1) or a wad")
     args = parser.parse_args()
     global GAME_WAD
-    from paper_agents_vizdoom import freedoom_path  # this script's folder is on the path
-
-    GAME_WAD = freedoom_path(args.freedoom)
+    try:
+        GAME_WAD = vizdoom_env.freedoom_path(args.freedoom)
+    except FileNotFoundError as error:
+        raise SystemExit(f"error: {error}") from None
     if args.light:
         light()
     elif args.sprite_light:

@@ -92,9 +92,12 @@ def main() -> None:
     if args.figure:
         figure(args.figure)
         return
-    import paper_agents_vizdoom
+    from mjmaze import vizdoom_env
 
-    source = paper_agents_vizdoom.freedoom_path(args.freedoom)
+    try:
+        source = vizdoom_env.freedoom_path(args.freedoom)
+    except FileNotFoundError as error:
+        raise SystemExit(f"error: {error}") from None
     lumps = sprites.read_wad(pathlib.Path(source).read_bytes())
     data = sprites.write_wad(wanted_lumps(lumps))
     if args.check:

@@ -14,7 +14,7 @@
 RELEASED_CHECKOUT is a checkout of github.com/edbeeching/3d_control_deep_rl
 (its ``3dcdrl/scenarios/custom_scenarios/`` holds each maze's ``.cfg``/``.wad``,
 its ``3dcdrl/saved_models/`` the agents, which ``mjmaze.train.paper_agents`` loads).
-Needs ``pip install -e ".[bench]"`` (ViZDoom, and OpenCV for the released resize).
+Needs ``pip install -e ".[train,vizdoom]"`` (torch for the agents; ViZDoom, and OpenCV for the released resize).
 
 Each agent plays its setting's mazes as ``mjmaze.train.evaluate`` plays them
 in mjmaze: the first 64 of ``train`` and the 64 of ``test``, each twice, the
@@ -39,13 +39,9 @@ format, which ``paper_table --vizdoom`` puts beside mjmaze's.
 from __future__ import annotations
 
 import argparse
-import hashlib
-import io
 import json
 import multiprocessing as mp
 import pathlib
-import tarfile
-import urllib.request
 
 import numpy as np
 import torch
@@ -54,103 +50,24 @@ from mjmaze import files, rules, sprites, suite
 from mjmaze.doom import FIRST_OBSERVATION_TIC, MAP_UNIT, TICS_PER_STEP
 from mjmaze.tasks import two_colour
 from mjmaze.train import paper_agents
+# The engine adapter that mjmaze's training and evaluation play ViZDoom through: one copy of how the
+# released env set a game up, drew its frame and paid its metric.
+from mjmaze.vizdoom_env import FRAME_SIZE as SIZE
+from mjmaze.vizdoom_env import LIMITED_ACTIONS, episode_metrics, freedoom_path
+from mjmaze.vizdoom_env import frame as _frame
+from mjmaze.vizdoom_env import maze_seed as _maze_seed
+from mjmaze.vizdoom_env import released_game as _game
 
-LIMITED_ACTIONS = ([True, False, False, False], [False, True, False, False], [False, False, True, False],
-                   [True, False, True, False], [False, True, True, False])  # left, right, fwd, fwd+left, fwd+right
-FRAME_SKIP = 4
 _POSE = ("POSITION_X", "POSITION_Y", "ANGLE")
-SIZE = (112, 64)
 PLAYS_PER_MAZE = 2
 BATCH = 16  # mazes played side by side (one network batch)
 DEFAULT_OUT = pathlib.Path("runs/paper/vizdoom.json")  # what paper_table --vizdoom reads by default
-# The paper's Freedoom: ViZDoom 1.1.4 (the released README's) built with Freedoom 0.10.1.
-PAPER_FREEDOOM_DEB = "http://archive.ubuntu.com/ubuntu/pool/universe/f/freedoom/freedoom_0.10.1-1_all.deb"
-PAPER_FREEDOOM_SHA256 = "91c2b5a7454f684dc0141ea50086e94ae0483c9ab04ba97393bb47e703e18c63"  # its freedoom2.wad
+FRAME_SKIP = TICS_PER_STEP  # agent steps hold each action 4 tics
 
 
-def paper_freedoom() -> pathlib.Path:
-    """Freedoom 0.10.1's ``freedoom2.wad``, the game data the paper's agents saw, fetched once into the cache."""
-    target = paper_agents.cache_dir() / "freedoom-0.10.1" / "freedoom2.wad"
-    if target.exists():
-        return target
-    try:
-        with urllib.request.urlopen(PAPER_FREEDOOM_DEB, timeout=120) as response:
-            deb = response.read()
-    except (urllib.error.URLError, TimeoutError, OSError) as error:
-        raise SystemExit(f"error: could not download {PAPER_FREEDOOM_DEB} ({error}); pass --freedoom PATH to a "
-                         "Freedoom 0.10.1 freedoom2.wad, or --freedoom vizdoom for ViZDoom's own") from None
-    # A .deb is an ar archive (a 60-byte header per member); the files are in data.tar.*.
-    offset = 8
-    while offset < len(deb):
-        name, size = deb[offset:offset + 16].decode().strip().rstrip("/"), int(deb[offset + 48:offset + 58])
-        if name.startswith("data.tar"):
-            with tarfile.open(fileobj=io.BytesIO(deb[offset + 60:offset + 60 + size])) as tar:
-                wad = tar.extractfile("./usr/share/games/doom/freedoom2.wad").read()
-            break
-        offset += 60 + size + size % 2
-    else:
-        raise SystemExit(f"error: {PAPER_FREEDOOM_DEB} holds no data archive")
-    if hashlib.sha256(wad).hexdigest() != PAPER_FREEDOOM_SHA256:
-        raise SystemExit(f"error: the freedoom2.wad in {PAPER_FREEDOOM_DEB} is not Freedoom 0.10.1's; nothing cached")
-    return files.atomic_write_bytes(target, wad)
-
-
-def freedoom_path(choice: str) -> str | None:
-    """``--freedoom``'s game data: ``paper`` (0.10.1), ``vizdoom`` (None: ViZDoom's own) or a wad's path."""
-    if choice == "paper":
-        return str(paper_freedoom())
-    if choice == "vizdoom":
-        return None
-    if not pathlib.Path(choice).is_file():
-        raise SystemExit(f"error: --freedoom {choice}: no such file (paper, vizdoom or a freedoom2.wad)")
-    return choice
-
-
-def _game(cfg: pathlib.Path, seed: int = 0, objects: bool = False, wad: str | None = None,
-          teleport: bool = False, labels: bool = False):
-    """The released maze's game; ``teleport``: with cheats on (the ``warp`` command) and a fifth button that
-    turns by a given angle, to put the player at any pose; ``labels``: with the buffer of where things are drawn."""
-    import vizdoom as vzd
-
-    game = vzd.DoomGame()
-    game.load_config(str(cfg))
-    if teleport:
-        game.add_available_button(vzd.Button.TURN_LEFT_RIGHT_DELTA)
-        game.add_game_args("+sv_cheats 1")
-    if wad is not None:
-        game.set_doom_game_path(wad)  # the released .cfg names none: ViZDoom's own freedoom2.wad
-    game.set_seed(seed)  # Doom's random spawn heading and item draws: the same episodes on every run
-    game.set_screen_resolution(vzd.ScreenResolution.RES_320X180)  # as the released env sets it after the cfg
-    game.set_sound_enabled(False)
-    game.set_window_visible(False)
-    game.set_objects_info_enabled(objects)  # every thing's name and position, each state
-    game.set_labels_buffer_enabled(labels)
-    game.init()
-    return game
-
-
-def _maze_seed(seed: int, index: int) -> int:
-    """Doom's seed for maze ``index`` of a run seeded ``seed``: other seeds, other episodes of the same mazes."""
-    return seed * 1000 + index
-
-
-def _frame(game) -> np.ndarray:
-    import cv2
-
-    screen = game.get_state().screen_buffer  # CRCGCB (the cfg): (3, 180, 320)
-    return cv2.resize(screen.transpose(1, 2, 0), SIZE, interpolation=cv2.INTER_AREA)
-
-
-def _metric(scenario: str, rewards: list[float], steps: int, num_items: int | None) -> float:
+def _metric(scenario: str, rewards: list[float], steps: int, difficulty: int) -> float:
     """The episode's metric in the units ``evaluate`` averages (success 0/1, item score, tics)."""
-    paid = sum(r > 0.25 for r in rewards)  # steps where a released script paid a +0.5 or +1
-    if scenario == "labyrinth":
-        return float(paid >= 1)
-    if scenario == "find_return":
-        return float(paid >= 2)
-    if scenario == "k_item":
-        return paid / num_items
-    return float(steps * FRAME_SKIP)  # two_colour: tics survived
+    return float(episode_metrics(scenario, rewards, steps, difficulty)[suite.paper_metric(scenario)[0]])
 
 
 def play(job: tuple[str, str, str, int, int, int, str | None]) -> tuple[str, str, dict]:
@@ -169,7 +86,6 @@ def play(job: tuple[str, str, str, int, int, int, str | None]) -> tuple[str, str
     _, agent, _ = paper_agents.load(name, paper_dir=checkout)
     folder = pathlib.Path(checkout) / paper_agents.MAZES / info.maze_folder / split
     field, scale, _ = suite.paper_metric(info.scenario)
-    num_items = info.difficulty if info.scenario == "k_item" else None
     episodes = []
     mazes = list(range(paper_agents.MAZES_PER_SPLIT))
     for first in range(0, len(mazes), BATCH):
@@ -191,7 +107,7 @@ def play(job: tuple[str, str, str, int, int, int, str | None]) -> tuple[str, str
                 rewards[i].append(games[i].make_action(LIMITED_ACTIONS[int(logits[slot].argmax())], FRAME_SKIP))
                 if games[i].is_episode_finished():
                     steps = len(rewards[i])
-                    value = _metric(info.scenario, rewards[i], steps, num_items)
+                    value = _metric(info.scenario, rewards[i], steps, info.difficulty)
                     episodes.append({"config_index": batch[i], "value": value * scale, "return": sum(rewards[i]),
                                      "length": steps})
                     plays[i] += 1
@@ -790,7 +706,10 @@ def main() -> None:
     if args.mazes is not None and args.mazes < 1:
         raise SystemExit(f"error: --mazes must be 1 or more, got {args.mazes}")
     mazes = args.mazes or (64 if args.swap else 8)
-    wad = freedoom_path(args.freedoom)
+    try:
+        wad = freedoom_path(args.freedoom)
+    except FileNotFoundError as error:
+        raise SystemExit(f"error: {error}") from None
     if args.agreement:
         scenario = paper_agents.get(args.agreement).scenario
         if scenario not in ("labyrinth", "two_colour"):

@@ -34,7 +34,7 @@ import torch
 import tyro
 from torch.nn import functional as F
 
-from mjmaze import files, registry, suite
+from mjmaze import files, suite
 from mjmaze.vector import WorkerError, make_vector_env
 
 from . import checkpoint, published
@@ -80,11 +80,10 @@ class _Stop(Exception):
 def train(args: Args) -> pathlib.Path:
     """Trains, checkpointing as it goes; returns the run's folder."""
     args.validate()
-    task_kwargs = args.task_kwargs()
     run_dir = pathlib.Path(args.runs_dir) / args.name()
     checkpoint_dir = run_dir / "checkpoints"
     # The env id names the scenario's version (look, motion, rules, seeds), as gymnasium's ids do.
-    config = dataclasses.asdict(args) | {"env_id": registry.get(args.scenario).gym_id}
+    config = dataclasses.asdict(args) | {"env_id": args.env_id()}
     if run_dir.exists() and checkpoint.checkpoints(checkpoint_dir) and not args.resume:
         raise FileExistsError(f"{run_dir} already holds a run: pass --resume to go on, or another --run-name")
     state = None
@@ -101,15 +100,7 @@ def train(args: Args) -> pathlib.Path:
     if args.torch_threads:
         torch.set_num_threads(args.torch_threads)
     torch.manual_seed(args.seed)
-    if args.backend == "warp":
-        # The envs live on the network's device: observations never leave it.
-        options = dict(device=str(device), keep_final_obs=False, cuda_graph=args.cuda_graph)
-    else:
-        options = dict(num_workers=args.num_workers, copy=False)
-    make_envs = functools.partial(
-        make_vector_env, args.num_envs, args.scenario, backend=args.backend, autoreset_mode="same_step",
-        split="train", **options, **task_kwargs,
-    )
+    make_envs = training_envs(args, device)
     envs = make_envs()
     try:
         agent = Agent(envs.single_action_space.n, envs.single_observation_space.shape).to(device)
@@ -124,6 +115,26 @@ def train(args: Args) -> pathlib.Path:
         envs.close()
         raise
     return _loop(args, make_envs, envs, agent, optimizer, device, run_dir, step, update)
+
+
+def training_envs(args: Args, device: torch.device) -> functools.partial:
+    """What makes the run's training envs (again, when a worker dies): same-step autoreset, the train split."""
+    if args.engine == "vizdoom":
+        from mjmaze import vizdoom_env
+
+        return functools.partial(
+            vizdoom_env.make_vector_env, args.num_envs, args.scenario, args.difficulty_value(), split="train",
+            released_dir=args.released_dir, freedoom=args.freedoom, head_bob=args.head_bob,
+        )
+    if args.backend == "warp":
+        # The envs live on the network's device: observations never leave it.
+        options = dict(device=str(device), keep_final_obs=False, cuda_graph=args.cuda_graph)
+    else:
+        options = dict(num_workers=args.num_workers, copy=False)
+    return functools.partial(
+        make_vector_env, args.num_envs, args.scenario, backend=args.backend, autoreset_mode="same_step",
+        split="train", **options, **args.task_kwargs(),
+    )
 
 
 def _loop(args, make_envs, envs, agent, optimizer, device, run_dir, step, update) -> pathlib.Path:

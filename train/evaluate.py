@@ -17,18 +17,19 @@ and prints the table.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import pathlib
 
 import numpy as np
 import torch
 from tqdm import tqdm
 
-from mjmaze import cli, files, registry, suite
+from mjmaze import cli, files, suite
 from mjmaze.vector import MazeVectorEnv, make_vector_env
 
 from . import checkpoint, policy, published
 from .model import Agent
-from .settings import INFERENCE_THREADS, Args, pick_device, using_torch_threads
+from .settings import ENGINES, INFERENCE_THREADS, Args, pick_device, using_torch_threads
 
 EVAL_CONFIGS = 64
 PLAYS_PER_CONFIG = 2
@@ -71,7 +72,14 @@ def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, devic
     task_kwargs = {k: v for k, v in args.task_kwargs().items() if k != "num_configs"}
     if layouts is not None:
         task_kwargs["layouts"] = layouts
-    if backend == "cpu":
+    if args.engine == "vizdoom":  # the released setting's first num_configs mazes of the split, in ViZDoom
+        from mjmaze import vizdoom_env
+
+        envs = vizdoom_env.make_vector_env(
+            num_envs, args.scenario, args.difficulty_value(), split=split, released_dir=args.released_dir,
+            num_configs=num_configs, order="cycle", freedoom=args.freedoom, head_bob=args.head_bob,
+        )
+    elif backend == "cpu":
         envs = MazeVectorEnv(
             num_envs, args.scenario, autoreset_mode="same_step", copy=False, split=split,
             num_configs=num_configs, config_sampling="cycle", **task_kwargs,
@@ -140,7 +148,7 @@ def evaluate_random(args: Args, num_envs: int = 16, out: str | pathlib.Path | No
     check_sizes(num_envs, num_configs, plays_per_config)
     result = {
         "run": "random", "checkpoint": None, "step": 0, "scenario": args.scenario,
-        "env_id": registry.get(args.scenario).gym_id,
+        "env_id": args.env_id(),
         "task_kwargs": args.task_kwargs(), "units": suite.paper_metric(args.scenario)[2],
     }
     for split in ("train", "test"):
@@ -154,9 +162,13 @@ def evaluate_random(args: Args, num_envs: int = 16, out: str | pathlib.Path | No
 def evaluate(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | None = None, num_envs: int = 16,
              device: str = "auto", out: str | pathlib.Path | None = None, num_configs: int | None = None,
              torch_threads: int | None = INFERENCE_THREADS, progress: bool = True,
-             plays_per_config: int = PLAYS_PER_CONFIG, seed: int = 0, sampled: bool = False) -> dict:
+             plays_per_config: int = PLAYS_PER_CONFIG, seed: int = 0, sampled: bool = False,
+             engine: dict | None = None) -> dict:
     """Evaluates a run's checkpoint (default: its latest) on train and test (greedy; ``sampled``: actions
     drawn from the policy, as in training).
+
+    ``engine``: settings that replace the run's own, to play it elsewhere
+    (``{"engine": "vizdoom", "released_dir": ...}``: the released mazes in ViZDoom).
 
     ``num_configs`` configurations per split (default ``EVAL_CONFIGS`` = 64),
     each played ``plays_per_config`` times, the envs seeded with ``seed``.
@@ -167,24 +179,26 @@ def evaluate(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | 
     torch_device = pick_device(device)
     with using_torch_threads(torch_threads):
         return _evaluate(run_dir, checkpoint_path, num_envs, torch_device, out, num_configs, progress,
-                         plays_per_config, seed, sampled)
+                         plays_per_config, seed, sampled, engine or {})
 
 
 def _evaluate(run_dir, checkpoint_path, num_envs, torch_device, out, num_configs, progress, plays_per_config,
-              seed, sampled=False) -> dict:
+              seed, sampled=False, engine=None) -> dict:
     args, agent, state = policy.load_run(run_dir, checkpoint_path, torch_device)
+    args = dataclasses.replace(args, **(engine or {}))
     result = {
         "run": str(run_dir),
         "checkpoint": state["path"],
         "step": int(state["step"]),
         "scenario": args.scenario,
-        "env_id": registry.get(args.scenario).gym_id,  # its version: what the frames and rules were
+        "env_id": args.env_id(),  # its version: what the frames and rules were (or ViZDoom's setting)
         # What the run trained on (config.json; runs from before ids were saved say nothing).
         "trained_env_id": policy.trained_env_id(run_dir),
         "task_kwargs": args.task_kwargs(),
         "units": suite.paper_metric(args.scenario)[2],
     }
-    layouts = state.get("layouts", {})  # a paper agent's released mazes
+    # A paper agent's released mazes (ViZDoom plays its own copies of them).
+    layouts = state.get("layouts", {}) if args.engine == "mjmaze" else {}
     if layouts:
         result["released_mazes"] = layouts
     for split in ("train", "test"):
@@ -227,16 +241,24 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--plays", type=int, default=PLAYS_PER_CONFIG,
                         help=f"episodes per configuration (default {PLAYS_PER_CONFIG})")
     parser.add_argument("--seed", type=int, default=0, help="seeds the envs' random draws (spawn heading, items)")
+    parser.add_argument("--engine", choices=ENGINES, default=None,
+                        help="the game to play: mjmaze, or vizdoom (the released .cfg/.wad mazes; default: the "
+                        "engine the run trained on, mjmaze for random and paper:<setting>)")
+    parser.add_argument("--released-dir", default=None,
+                        help="with --engine vizdoom: a checkout of the released repository (default: $MJMAZE_PAPER_DIR)")
     cli.difficulty_arguments(parser)  # for random: the scenario and its difficulty
     args = parser.parse_args(argv)
+    engine = {} if args.engine is None else {"engine": args.engine}
+    engine |= {} if args.released_dir is None else {"released_dir": args.released_dir}
     try:
         if str(args.run_dir) == "random":
-            settings = Args(scenario=args.scenario or suite.DEFAULT_SCENARIO, **cli.difficulty_kwargs(args))
+            settings = Args(scenario=args.scenario or suite.DEFAULT_SCENARIO, **cli.difficulty_kwargs(args), **engine)
             result = evaluate_random(settings, args.num_envs, args.out, seed=args.seed,
                                      plays_per_config=args.plays)
         else:
             result = evaluate(args.run_dir, args.checkpoint, args.num_envs, args.device, out=args.out,
-                              torch_threads=args.torch_threads, plays_per_config=args.plays, seed=args.seed)
+                              torch_threads=args.torch_threads, plays_per_config=args.plays, seed=args.seed,
+                              engine=engine)
     except (checkpoint.CheckpointError, FileNotFoundError, ValueError) as error:
         raise SystemExit(f"error: {error}") from None
     print(format_table(result))

@@ -39,17 +39,17 @@ import urllib.request
 
 import torch
 
-from mjmaze import files, registry
+from mjmaze import files, registry, vizdoom_env
 
 from .model import Agent
 from .settings import Args
 
 PREFIX = "paper:"
-RELEASED_REPOSITORY = "edbeeching/3d_control_deep_rl"
+RELEASED_REPOSITORY = vizdoom_env.RELEASED_REPOSITORY
 RELEASED_COMMIT = "d8cca7c2a57bcb3af215d4c26863e2a0e7c7ddac"  # the files below are this commit's
 DOWNLOAD_ROOT = f"https://raw.githubusercontent.com/{RELEASED_REPOSITORY}/{RELEASED_COMMIT}/"
 CHECKPOINTS = "3dcdrl/saved_models"
-MAZES = "3dcdrl/scenarios/custom_scenarios"
+MAZES = vizdoom_env.MAZES
 # Mazes a paper agent plays per split: the released evaluation's 64 test mazes, and as many training ones.
 MAZES_PER_SPLIT = 64
 # The released state dict's layer names -> mjmaze's Agent's.
@@ -113,8 +113,7 @@ def _agents() -> dict[str, PaperAgent]:
         ("two_colour", 7): ("two_col_p7_checkpoint_0198658048.pth.tar",
                             "890d3ae792b4d2cf9242eac0ed8c3a8dfb7387298c3b502127eed3b50e31a7ba"),
     }
-    # The released scenario folders' names.
-    folders = {"labyrinth": "labyrinth", "find_return": "find_return", "k_item": "kitem", "two_colour": "two_color"}
+    folders = vizdoom_env.RELEASED_FOLDERS
     return {
         f"{scenario}_{difficulty}": PaperAgent(f"{scenario}_{difficulty}", scenario, difficulty, file, digest,
                                                 f"{folders[scenario]}/{difficulty}")
@@ -139,7 +138,7 @@ def get(source: str) -> PaperAgent:
 
 
 def cache_dir() -> pathlib.Path:
-    return pathlib.Path(os.environ.get("XDG_CACHE_HOME") or pathlib.Path.home() / ".cache") / "mjmaze" / "paper"
+    return files.cache_dir() / "paper"
 
 
 def _local_roots(paper_dir: str | os.PathLike | None) -> list[pathlib.Path]:

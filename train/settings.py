@@ -56,6 +56,12 @@ class _RunSettings:
     """Doom's full-screen flashes (red when hurt, gold on a pickup); --no-flashes leaves the view untinted"""
     backend: str = "cpu"
     """where the envs run: cpu (worker processes) or warp (every env in one MuJoCo Warp model on --device, beside the network; pip install "mjmaze[warp]")"""
+    engine: str = "mjmaze"
+    """the game the envs play: mjmaze, or vizdoom (the paper's released .cfg/.wad mazes in ViZDoom, as its code played them; pip install -e ".[vizdoom]" and --released-dir)"""
+    released_dir: str | None = None
+    """with --engine vizdoom: a checkout of github.com/edbeeching/3d_control_deep_rl (None: $MJMAZE_PAPER_DIR)"""
+    freedoom: str = "paper"
+    """with --engine vizdoom: the game data: paper (Freedoom 0.10.1, fetched once), vizdoom (ViZDoom's own) or a freedoom2.wad"""
     cuda_graph: bool = False
     """with --backend warp on a GPU: replay each env step as one CUDA graph (mjmaze.warp.MazeBatchEnv's cuda_graph)"""
     torch_threads: int | None = None
@@ -110,6 +116,35 @@ class _RunSettings:
             raise ValueError("--cuda-graph replays the Warp backend's steps: pass it with --backend warp")
         pick_device(self.device)
         suite.make_task(self.scenario, self.task_kwargs())  # the scenario checks its own arguments
+        if self.engine not in ENGINES:
+            raise ValueError(f"--engine must be one of {ENGINES}, got {self.engine!r}")
+        if self.engine == "vizdoom":
+            self._validate_vizdoom()
+
+    def _validate_vizdoom(self) -> None:
+        from mjmaze import vizdoom_env
+
+        if self.backend != "cpu":
+            raise ValueError("--engine vizdoom runs ViZDoom in worker processes: leave --backend at cpu")
+        kwargs = self.task_kwargs()
+        unplayable = set(kwargs) - {registry.get(self.scenario).difficulty, "head_bob"}
+        if unplayable:
+            raise ValueError(f"--engine vizdoom plays the released mazes as released: it takes the difficulty and "
+                             f"--no-head-bob, not {sorted(unplayable)}")
+        vizdoom_env.released_folder(self.scenario, self.difficulty_value(), "train", self.released_dir)
+
+    def difficulty_value(self) -> int:
+        """The difficulty this run plays (the flag, or the scenario's default)."""
+        value = getattr(self, registry.get(self.scenario).difficulty, None)
+        return suite.default_difficulty(self.scenario) if value is None else value
+
+    def env_id(self) -> str:
+        """What the envs play: mjmaze's versioned gym id, or the released setting on ViZDoom."""
+        if self.engine == "vizdoom":
+            from mjmaze import vizdoom_env
+
+            return vizdoom_env.engine_id(self.scenario, self.difficulty_value(), self.freedoom)
+        return registry.get(self.scenario).gym_id
 
     def name(self) -> str:
         if self.run_name:
@@ -117,6 +152,8 @@ class _RunSettings:
         difficulty = registry.get(self.scenario).difficulty
         return f"{self.scenario}_{getattr(self, difficulty, None) or 'default'}_s{self.seed}"
 
+
+ENGINES = ("mjmaze", "vizdoom")
 
 # One flag per difficulty argument of the registered scenarios (--size,
 # --num-items, --complexity), read from the registry like the other tools'

@@ -1,0 +1,147 @@
+"""ViZDoom as the other engine: the released mazes played as the released code played them, for mjmaze's learner.
+
+The ViZDoom tests play four released mazes kept in tests/data/released (MIT, the
+released repository's); they skip where ViZDoom is not installed.
+"""
+
+import json
+import pathlib
+
+import numpy as np
+import pytest
+
+from mjmaze import vizdoom_env
+from mjmaze.doom import TICS_PER_STEP
+from mjmaze.train import a2c, evaluate
+from mjmaze.train.settings import Args
+
+RELEASED = pathlib.Path(__file__).parent / "data" / "released"
+FORWARD, TURN_LEFT = 2, 0
+
+
+@pytest.fixture
+def vizdoom():
+    return pytest.importorskip("vizdoom", reason='ViZDoom is an optional extra: pip install -e ".[vizdoom]"')
+
+
+def released_env(scenario="two_colour", difficulty=1, mazes=(0, 1), first=1):
+    folder = vizdoom_env.released_folder(scenario, difficulty, "train", RELEASED)
+    return vizdoom_env.ReleasedMazeEnv(scenario, difficulty, str(folder), mazes, first, wad=None)
+
+
+def test_each_env_owns_a_block_of_mazes_and_starts_at_its_last_as_released():
+    # multi_env.pipe_worker2 with --fixed_scenario: 256 mazes, 16 workers of 16; the deque's pop() takes the last.
+    envs = vizdoom_env.env_mazes(16, 256, "released")
+    assert [mazes for mazes, _ in envs] == [list(range(16 * i, 16 * i + 16)) for i in range(16)]
+    assert {first for _, first in envs} == {15}
+    # Evaluation's order: env i from configuration i * 64 / n on, through all 64.
+    assert [(mazes[0], first) for mazes, first in vizdoom_env.env_mazes(16, 64, "cycle")][:3] == [(0, 0), (0, 4), (0, 8)]
+    with pytest.raises(ValueError, match="at least 16 mazes"):
+        vizdoom_env.env_mazes(16, 8, "released")
+
+
+@pytest.mark.parametrize("scenario, rewards, steps, expected", [
+    ("labyrinth", [-0.0004] * 9 + [0.9996], 10, {"success": 1.0}),
+    ("labyrinth", [-0.0004] * 525, 525, {"success": 0.0}),
+    ("find_return", [-0.0004, 0.4996, -0.0004], 3, {"success": 0.0, "target_found": 1.0}),
+    ("find_return", [0.4996, 0.4996], 2, {"success": 1.0, "target_found": 1.0}),
+    ("k_item", [0.4996, -0.0004, -0.2504], 3, {"items_in_order": 1, "item_score": 0.5}),
+    ("two_colour", [0.04] * 100 + [1.04, 0.0], 102, {"duration": 102 * TICS_PER_STEP}),
+])
+def test_the_metric_is_read_off_the_rewards_the_released_scripts_pay(scenario, rewards, steps, expected):
+    metrics = vizdoom_env.episode_metrics(scenario, rewards, steps, difficulty=2)
+    assert {k: metrics[k] for k in expected} == expected
+
+
+def test_a_missing_checkout_or_setting_is_one_clear_error(tmp_path, monkeypatch):
+    monkeypatch.delenv("MJMAZE_PAPER_DIR", raising=False)
+    with pytest.raises(FileNotFoundError, match="--released-dir"):
+        vizdoom_env.released_folder("two_colour", 1, "train")
+    with pytest.raises(FileNotFoundError, match="checkout of edbeeching/3d_control_deep_rl"):
+        vizdoom_env.released_folder("two_colour", 1, "train", tmp_path)
+    with pytest.raises(ValueError, match="released no 'fifth'"):
+        vizdoom_env.released_folder("fifth", 1, "train", RELEASED)
+
+
+def test_training_flags_the_vizdoom_engine_cannot_play_are_refused():
+    common = dict(scenario="two_colour", complexity=1, engine="vizdoom", released_dir=str(RELEASED))
+    Args(**common).validate()
+    with pytest.raises(ValueError, match="leave --backend at cpu"):
+        Args(**common, backend="warp").validate()
+    with pytest.raises(ValueError, match="flashes"):
+        Args(**common, flashes=False).validate()
+    with pytest.raises(ValueError, match="--engine must be one of"):
+        Args(scenario="labyrinth", engine="doom").validate()
+    assert Args(**common).env_id() == "vizdoom:two_color/1@paper"
+
+
+def test_two_colour_pays_the_released_training_reward_and_counts_tics(vizdoom):
+    env = released_env()
+    try:
+        obs, _ = env.reset(seed=3)
+        assert obs.shape == (64, 112, 3) and obs.dtype == np.uint8 and obs.std() > 0
+        assert env.mazes[env.position] == 1  # the block's last maze first
+        rewards, info, ended = [], {}, False
+        while not ended:
+            obs, reward, terminated, truncated, info = env.step(TURN_LEFT)  # standing still on the lava floor
+            rewards.append(reward)
+            ended = terminated or truncated
+        assert terminated and not truncated  # the floor killed it before the 2,100-tic limit
+        assert info["duration"] == len(rewards) * TICS_PER_STEP and info["config_index"] == 1
+        # 0.01 a tic alive, and +1 each time health rose (an item of the totem's colour walked into)
+        alive = np.isclose(rewards[:-1], 0.04) | np.isclose(rewards[:-1], 1.04)
+        assert alive.all() and info["episode_return"] == pytest.approx(sum(rewards))
+        env.reset()
+        assert env.mazes[env.position] == 0  # an episode's end moves to the next maze, cycling
+    finally:
+        env.close()
+
+
+def test_the_same_seed_plays_the_same_episode_and_another_seed_another(vizdoom):
+    def frames(seed):
+        env = released_env(first=0)
+        try:
+            shots = [env.reset(seed=seed)[0]]
+            shots += [env.step(FORWARD)[0] for _ in range(30)]
+            return np.stack(shots)
+        finally:
+            env.close()
+
+    assert np.array_equal(frames(1), frames(1))
+    assert not np.array_equal(frames(1), frames(2))  # Doom's draws: the spawn heading, the items
+
+
+def test_labyrinths_exit_pays_one_and_is_a_success(vizdoom):
+    env = released_env("labyrinth", 7, mazes=(0,), first=0)
+    rng = np.random.default_rng(0)
+    try:
+        env.reset(seed=0)
+        successes, returns = [], []
+        for _ in range(4000):  # a random walk: most episodes time out, a few find the exit
+            _, reward, terminated, truncated, info = env.step(int(rng.integers(5)))
+            if terminated or truncated:
+                successes.append(info["success"])
+                returns.append(info["episode_return"])
+                assert terminated == (info["success"] == 1.0)  # the exit ends it; else the 2,100 tics
+                env.reset()
+        assert successes
+        for success, episode_return in zip(successes, returns):
+            assert (episode_return > 0.5) == (success == 1.0)
+    finally:
+        env.close()
+
+
+@pytest.mark.slow
+def test_a2c_trains_on_vizdoom_and_evaluates_there(vizdoom, tmp_path):
+    args = Args(scenario="two_colour", complexity=1, engine="vizdoom", released_dir=str(RELEASED),
+                freedoom="vizdoom", num_envs=2, num_steps=16, total_steps=64, runs_dir=str(tmp_path),
+                progress=False, checkpoint_every=64)
+    run = a2c.train(args)
+    config = json.loads((run / "config.json").read_text())
+    assert config["env_id"] == "vizdoom:two_color/1@vizdoom" and config["engine"] == "vizdoom"
+    lines = [json.loads(line) for line in (run / "metrics.jsonl").read_text().splitlines()]
+    assert [line["step"] for line in lines] == [32, 64]
+    # Evaluation plays the engine the run trained on, the released order, each maze twice.
+    result = evaluate.evaluate(run, num_envs=2, num_configs=2, progress=False)
+    assert result["env_id"] == "vizdoom:two_color/1@vizdoom"
+    assert result["train"]["configs"] == [0, 0, 1, 1] and result["train"]["metric"] == "duration"
