@@ -145,3 +145,4 @@ def test_a2c_trains_on_vizdoom_and_evaluates_there(vizdoom, tmp_path):
     result = evaluate.evaluate(run, num_envs=2, num_configs=2, progress=False)
     assert result["env_id"] == "vizdoom:two_color/1@vizdoom"
     assert result["train"]["configs"] == [0, 0, 1, 1] and result["train"]["metric"] == "duration"
+

@@ -16,9 +16,10 @@ from mjmaze.files import atomic_write
 
 PREFIX, SUFFIX = "step_", ".pt"
 # What must agree between a checkpoint and the run that loads it.
-IDENTITY_KEYS = ("scenario", "size", "num_items", "complexity", "num_envs", "num_steps", "head_bob", "flashes")
+IDENTITY_KEYS = ("scenario", "size", "num_items", "complexity", "num_envs", "num_steps", "head_bob", "flashes",
+                 "engine", "freedoom")
 # Settings that runs saved before they existed ran with.
-MISSING_MEANS = {"head_bob": False, "flashes": False}
+MISSING_MEANS = {"head_bob": False, "flashes": False, "engine": "mjmaze", "freedoom": "paper"}
 
 
 def setting_of(config: dict, key: str):

@@ -78,9 +78,10 @@ def evaluate_checkpoints(run_dir: pathlib.Path, num_envs: int = 16,
 
 def group_key(config: dict) -> tuple:
     """What makes runs seeds of one curve: the scenario, its difficulty, the number of training configurations,
-    and what the agent saw (head-bob, flashes; runs saved before they existed ran without)."""
+    and what the agent saw (head-bob, flashes; runs saved before they existed ran without; the engine)."""
     return (config["scenario"], config.get("size"), config.get("num_items"), config.get("complexity"),
-            config.get("num_configs"), checkpoint.setting_of(config, "head_bob"), checkpoint.setting_of(config, "flashes"))
+            config.get("num_configs"), checkpoint.setting_of(config, "head_bob"), checkpoint.setting_of(config, "flashes"),
+            checkpoint.setting_of(config, "engine"))
 
 
 def setting(config: dict) -> str:
@@ -93,10 +94,11 @@ def setting(config: dict) -> str:
 
 
 def label(config: dict) -> str:
-    """The setting, and what set this group's frames apart (no head-bob, no flashes)."""
+    """The setting, and what set this group's frames apart (no head-bob, no flashes, ViZDoom's engine)."""
     missing = [name for key, name in (("head_bob", "head-bob"), ("flashes", "flashes"))
                if not checkpoint.setting_of(config, key)]
-    return setting(config) + (f" (no {', no '.join(missing)})" if missing else "")
+    engine = " on ViZDoom" if checkpoint.setting_of(config, "engine") == "vizdoom" else ""
+    return setting(config) + engine + (f" (no {', no '.join(missing)})" if missing else "")
 
 
 def first_time_limit(config: dict) -> int:

@@ -1,0 +1,61 @@
+"""The engines' comparison: each run's curve into the data file, the table of observations to the paper's levels."""
+
+import json
+import pathlib
+
+import numpy as np
+
+from mjmaze.train import engines
+
+
+def write_run(folder, engine, seed, values, scenario="two_colour", complexity=1, updates_per_bin=4):
+    """A run folder as train.a2c leaves it: config.json and one metrics line per update (2,048 steps each)."""
+    folder.mkdir(parents=True)
+    config = {"scenario": scenario, "complexity": complexity, "seed": seed, "engine": engine, "num_envs": 16,
+              "env_id": f"{engine}-id"}
+    (folder / "config.json").write_text(json.dumps(config))
+    per_update = engines.BIN_STEPS // updates_per_bin
+    lines = [json.dumps({"step": (i + 1) * per_update, "duration": value})
+             for i, value in enumerate(np.repeat(values, updates_per_bin))]
+    (folder / "metrics.jsonl").write_text("\n".join(lines) + "\n")
+    return folder
+
+
+def test_the_table_gives_the_observations_each_engine_needs_to_reach_the_papers_levels(tmp_path):
+    # The paper's Two-colour 1: 430 tics at 2.5M, 530 at 5M, 700 at 10M (read off its plots).
+    climbing = np.linspace(300, 800, 40)  # 3-bin means reach 430 at 2.875M, 530 at 4.625M (bins of 0.25M)
+    flat = np.full(40, 440.0)
+    data_file = tmp_path / "engines.json"
+    engines.add([write_run(tmp_path / "m0", "mjmaze", 0, flat),
+                 write_run(tmp_path / "v0", "vizdoom", 0, climbing)], data_file)
+    data = engines.read_data(data_file)
+    assert [(r["engine"], r["seed"], len(r["train"])) for r in data["runs"]] == [("mjmaze", 0, 40), ("vizdoom", 0, 40)]
+    rows = engines.table(data).splitlines()[2:]
+    assert len(rows) == 3
+    level_430, level_530, level_700 = rows
+    assert "| 0.38M (1) | 2.88M (1) | 0.13 **over 1.5×** |" in level_430  # 440 from the start; ViZDoom climbs to it
+    assert "> 10.00M (1)" in level_530 and "> 2.1" in level_530  # mjmaze never reaches 530: a bound
+    # Adding a run again replaces its record (same setting, engine and seed).
+    engines.add([write_run(tmp_path / "m0b", "mjmaze", 0, climbing)], data_file)
+    data = engines.read_data(data_file)
+    assert len(data["runs"]) == 2
+    assert engines.table(data).splitlines()[2].endswith("| 1.00 |")
+
+
+def test_draw_rewrites_only_the_table_between_its_markers(tmp_path):
+    data_file = tmp_path / "engines.json"
+    engines.add([write_run(tmp_path / "v0", "vizdoom", 0, np.full(12, 500.0))], data_file)
+    page = tmp_path / "learning.md"
+    page.write_text(f"before\n{engines.TABLE_START}\nold table\n{engines.TABLE_END}\nafter\n")
+    plots = engines.draw(engines.read_data(data_file), tmp_path, page)
+    assert [p.name for p in plots] == ["engines_two_colour_1.png"] and plots[0].stat().st_size > 0
+    text = page.read_text()
+    assert text.startswith("before\n") and text.endswith("after\n") and "old table" not in text
+    assert "| not run |" in text  # no mjmaze run yet
+
+
+def test_the_committed_table_is_the_one_the_data_file_gives():
+    data = engines.read_data(pathlib.Path(__file__).parents[1] / engines.DATA)
+    page = (pathlib.Path(__file__).parents[1] / engines.LEARNING_PAGE).read_text()
+    between = page.split(engines.TABLE_START, 1)[1].split(engines.TABLE_END, 1)[0]
+    assert between.strip() == engines.table(data).strip(), "run python -m mjmaze.train.engines draw"

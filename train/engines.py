@@ -1,0 +1,254 @@
+"""One learner, both engines: mjmaze's and ViZDoom's curves of the same A2C beside the paper's.
+
+    python -m mjmaze.train.engines add runs/two_colour_1_s0 runs/vizdoom_two_colour_1_s0   # into the data file
+    python -m mjmaze.train.engines draw       # the plots, and the table in docs/learning.md, from the data file
+
+``add`` reads each training run (``--engine mjmaze`` or ``--engine vizdoom``:
+the same A2C, the same settings) and keeps its training curve, in
+:data:`BIN_STEPS` bins of agent steps, and its greedy evaluations where
+``mjmaze.train.curves --evaluate`` made them, in one small committed file
+(:data:`DATA`): run folders are local, the curves' data are not. ``draw``
+draws each setting's curves (both engines, mean over seeds, and the paper's
+points) into ``docs/engines_<setting>.png`` and writes the table of
+observations each engine needs to reach the paper's levels at 2.5M, 5M and
+10M into docs/learning.md between its markers, so that no figure there is
+typed by hand.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import pathlib
+import warnings
+
+import numpy as np
+
+from mjmaze import files, registry
+
+from . import checkpoint, curves, published
+from .analysis import save_figure
+
+DATA = pathlib.Path("docs/data/engines.json")
+DOCS = pathlib.Path("docs")
+LEARNING_PAGE = DOCS / "learning.md"
+TABLE_START = "<!-- engines table: python -m mjmaze.train.engines draw -->"
+TABLE_END = "<!-- end of engines table -->"
+BIN_STEPS = 250_000
+# The paper's points whose levels the table asks each engine to reach (agent steps).
+LEVEL_STEPS = (2_500_000, 5_000_000, 10_000_000)
+# Bins the curve is averaged over before it is read for a level: one bin of 16 envs holds a few hundred
+# episodes, and a level reached by one lucky bin is not reached.
+SMOOTH_BINS = 3
+# The widest gap between the engines, in observations to a level, that counts as the same learning.
+SAME_WITHIN = 1.5
+ENGINE_NAMES = {"mjmaze": "mjmaze", "vizdoom": "ViZDoom"}
+
+
+def setting_name(config: dict) -> str:
+    """``<scenario>_<difficulty>``, e.g. ``two_colour_1``: the paper's setting a run trained on."""
+    difficulty = config.get(registry.get(config["scenario"]).difficulty)
+    if difficulty is None:
+        raise ValueError(f"{config['scenario']} run without its difficulty in config.json: pass it when training")
+    return f"{config['scenario']}_{difficulty}"
+
+
+def run_record(run_dir: pathlib.Path) -> dict:
+    """A run's curve on the fixed grid of :data:`BIN_STEPS` bins (from the first time limit on) and its evaluations."""
+    run = curves.read_run(run_dir)
+    config = run["config"]
+    if not len(run["steps"]):
+        raise ValueError(f"{run_dir} has no training episodes in metrics.jsonl yet")
+    if config.get("num_configs") is not None:
+        raise ValueError(f"{run_dir} trained on {config['num_configs']} configurations: the paper's curves are of 256")
+    kept = run["steps"] >= curves.first_time_limit(config)
+    which = (run["steps"][kept] - 1) // BIN_STEPS
+    bins = int(which.max()) + 1 if len(which) else 0
+    sums = np.bincount(which, weights=run["values"][kept], minlength=bins)
+    counts = np.bincount(which, minlength=bins)
+    return {
+        "setting": setting_name(config),
+        "engine": checkpoint.setting_of(config, "engine"),
+        "seed": int(config["seed"]),
+        "env_id": config.get("env_id"),
+        "field": published.curve_field(config["scenario"]),
+        "steps": int(run["steps"].max()),
+        # Each bin's mean of the updates' training means (None where no episode ended), 4 significant digits.
+        "train": [float(f"{v:.4g}") if c else None for v, c in zip(sums / np.maximum(counts, 1), counts)],
+        "evaluations": {str(step): [float(f"{a:.4g}"), float(f"{b:.4g}")] for step, (a, b) in sorted(run["evals"].items())},
+        "added": datetime.date.today().isoformat(),
+    }
+
+
+def read_data(path: pathlib.Path = DATA) -> dict:
+    if not path.exists():
+        return {"bin_steps": BIN_STEPS, "runs": []}
+    data = json.loads(path.read_text())
+    if data.get("bin_steps") != BIN_STEPS:
+        raise ValueError(f"{path} holds {data.get('bin_steps')}-step bins, this version {BIN_STEPS}: add the runs again")
+    return data
+
+
+def add(run_dirs: list[pathlib.Path], path: pathlib.Path = DATA) -> dict:
+    """Puts each run's record into the data file, replacing the record of the same setting, engine and seed."""
+    data = read_data(path)
+    for run_dir in run_dirs:
+        record = run_record(pathlib.Path(run_dir))
+        key = (record["setting"], record["engine"], record["seed"])
+        data["runs"] = [r for r in data["runs"] if (r["setting"], r["engine"], r["seed"]) != key] + [record]
+    data["runs"].sort(key=lambda r: (r["setting"], r["engine"], r["seed"]))
+    files.atomic_write_json(path, data)
+    return data
+
+
+def mean_curve(records: list[dict]) -> tuple[np.ndarray, np.ndarray]:
+    """``(bin centres, mean over the records)``, as far as every record reaches; NaN where none has episodes."""
+    length = min(len(r["train"]) for r in records)
+    values = np.array([[np.nan if v is None else v for v in r["train"][:length]] for r in records], dtype=float)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # a bin where no seed had an episode stays NaN
+        mean = np.nanmean(values, axis=0) if length else np.array([])
+    return (np.arange(length) + 0.5) * BIN_STEPS, mean
+
+
+def steps_to_reach(records: list[dict], level: float) -> tuple[int | None, int]:
+    """The first agent step at which the seeds' mean curve, averaged over :data:`SMOOTH_BINS` bins, reaches
+    ``level`` (the middle of the first window that does); None if it has not by its last bin. Also that last step."""
+    _, mean = mean_curve(records)
+    last = min(r["steps"] for r in records)  # as far as every seed has trained
+    if len(mean) < SMOOTH_BINS:
+        return None, last
+    filled = np.where(np.isnan(mean), -np.inf, mean)
+    smooth = np.convolve(filled, np.ones(SMOOTH_BINS) / SMOOTH_BINS, mode="valid")
+    reached = np.flatnonzero(smooth >= level)
+    # Window k spans bins k .. k + SMOOTH_BINS - 1: its mean stands for the step at its middle.
+    return (int((reached[0] + SMOOTH_BINS / 2) * BIN_STEPS) if len(reached) else None), last
+
+
+def paper_levels(setting: str) -> list[tuple[int, float]]:
+    """The paper's ``(step, value)`` points of ``setting`` at :data:`LEVEL_STEPS`."""
+    scenario, _, difficulty = setting.rpartition("_")
+    points = dict(published.of(scenario).curves.get(int(difficulty), ()))
+    return [(step, points[step]) for step in LEVEL_STEPS if step in points]
+
+
+def _millions(steps: int | None, last: int) -> str:
+    return f"{steps / 1e6:.2f}M" if steps is not None else f"> {last / 1e6:.2f}M"
+
+
+def table(data: dict) -> str:
+    """The markdown table: per setting and paper level, the observations each engine's seeds needed, and their ratio."""
+    lines = ["| setting | paper's level (its step) | mjmaze: obs to reach it (seeds) | ViZDoom: obs (seeds) | mjmaze ÷ ViZDoom |",
+             "|---|---|---|---|---|"]
+    for setting in sorted({r["setting"] for r in data["runs"]}):
+        scenario = setting.rpartition("_")[0]
+        units, digits = published.curve_units(scenario), published.of(scenario).metric_digits
+        by_engine = {engine: [r for r in data["runs"] if r["setting"] == setting and r["engine"] == engine]
+                     for engine in ENGINE_NAMES}
+        for step, level in paper_levels(setting):
+            cells, reached = [], {}
+            for engine, records in by_engine.items():
+                if not records:
+                    cells.append("not run")
+                    continue
+                at, last = steps_to_reach(records, level)
+                reached[engine] = (at, last)
+                cells.append(f"{_millions(at, last)} ({len(records)})")
+            ratio = _ratio(reached)
+            lines.append(f"| {setting} | {level:.{digits}f} {units} ({step / 1e6:g}M) | {cells[0]} | {cells[1]} | {ratio} |")
+    return "\n".join(lines)
+
+
+def _ratio(reached: dict) -> str:
+    """mjmaze's observations over ViZDoom's: a number where both reached the level, a bound where one did."""
+    if len(reached) < 2:
+        return "–"
+    (ours, our_last), (theirs, their_last) = reached["mjmaze"], reached["vizdoom"]
+    if ours is not None and theirs is not None:
+        ratio = ours / theirs
+        flag = "" if 1 / SAME_WITHIN <= ratio <= SAME_WITHIN else " **over 1.5×**"
+        return f"{ratio:.2f}{flag}"
+    if ours is not None:
+        return f"< {ours / their_last:.2f}"
+    if theirs is not None:
+        return f"> {our_last / theirs:.2f}"
+    return "neither yet"
+
+
+def figure(data: dict, setting: str):
+    """Both engines' training curves (mean over seeds, each seed thin) and greedy test evaluations, and the paper's points."""
+    from matplotlib.figure import Figure
+
+    scenario = setting.rpartition("_")[0]
+    fig = Figure(figsize=(6.4, 4.2))
+    ax = fig.subplots()
+    reach = 0
+    for colour, (engine, name) in zip(("C0", "C1"), ENGINE_NAMES.items()):
+        records = [r for r in data["runs"] if r["setting"] == setting and r["engine"] == engine]
+        if not records:
+            continue
+        for r in records:
+            x = (np.arange(len(r["train"])) + 0.5) * BIN_STEPS
+            y = np.array([np.nan if v is None else v for v in r["train"]], dtype=float)
+            ax.plot(x, y, color=colour, linewidth=0.6, alpha=0.5)
+            reach = max(reach, r["steps"])
+        x, mean = mean_curve(records)
+        seeds = ", ".join(str(r["seed"]) for r in records)
+        ax.plot(x, mean, color=colour, linewidth=2, label=f"{name}, training episodes (seed {seeds})")
+        tests = sorted((int(s), v[1]) for r in records for s, v in r["evaluations"].items())
+        if tests and published.curve_field(scenario) == registry.get(scenario).metric:
+            ax.plot(*zip(*tests), color=colour, marker="x", linestyle="none", label=f"{name}, greedy on test mazes")
+    paper = [(s, v) for s, v in published.of(scenario).curves.get(int(setting.rpartition("_")[2]), ())
+             if s <= max(reach * 1.5, LEVEL_STEPS[0])]
+    if paper:
+        ax.plot(*zip(*paper), color="black", marker="s", linestyle=":", label="the paper (read off its plots)")
+    ax.set_title(f"{setting}: one A2C on both engines", fontsize=10)
+    ax.set_xlabel("agent steps (observations)")
+    ax.set_ylabel(published.curve_units(scenario))
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="best")
+    return fig
+
+
+def draw(data: dict, docs: pathlib.Path = DOCS, page: pathlib.Path | None = LEARNING_PAGE) -> list[pathlib.Path]:
+    """Writes each setting's plot into ``docs`` and the table into ``page`` (between its markers); returns the plots."""
+    written = [save_figure(figure(data, setting), docs / f"engines_{setting}.png")
+               for setting in sorted({r["setting"] for r in data["runs"]})]
+    if page is not None:
+        text = page.read_text()
+        if TABLE_START not in text or TABLE_END not in text:
+            raise ValueError(f"{page} has no {TABLE_START} ... {TABLE_END} markers for the table")
+        head, rest = text.split(TABLE_START, 1)
+        tail = rest.split(TABLE_END, 1)[1]
+        files.atomic_write_bytes(page, f"{head}{TABLE_START}\n{table(data)}\n{TABLE_END}{tail}".encode())
+    return written
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    commands = parser.add_subparsers(dest="command", required=True)
+    adding = commands.add_parser("add", help="put runs' curves into the data file")
+    adding.add_argument("runs", nargs="+", type=pathlib.Path, help="training run folders (either engine)")
+    drawing = commands.add_parser("draw", help="the plots and docs/learning.md's table from the data file")
+    drawing.add_argument("--docs", type=pathlib.Path, default=DOCS, help="where the plots go (default docs/)")
+    drawing.add_argument("--page", type=pathlib.Path, default=LEARNING_PAGE,
+                         help="the page whose table is rewritten (default docs/learning.md)")
+    for sub in (adding, drawing):
+        sub.add_argument("--data", type=pathlib.Path, default=DATA, help=f"the data file (default {DATA})")
+    args = parser.parse_args(argv)
+    try:
+        if args.command == "add":
+            data = add(args.runs, args.data)
+            print(f"{len(args.runs)} run(s) into {args.data} ({len(data['runs'])} in all)")
+        else:
+            data = read_data(args.data)
+            for path in draw(data, args.docs, args.page):
+                print(f"written: {path}")
+            print(table(data))
+    except (checkpoint.CheckpointError, FileNotFoundError, ValueError) as error:
+        raise SystemExit(f"error: {error}") from None
+
+
+if __name__ == "__main__":
+    main()
