@@ -18,8 +18,8 @@ import time
 import numpy as np
 
 import mjmaze
-from mjmaze.group import EnvGroup
-from mjmaze.tasks import base
+from mjmaze.backends import dm_task as base
+from mjmaze.backends.group import EnvGroup
 
 SETTINGS = {"two_colour": {"complexity": 1}, "find_return": {"size": 5}, "k_item": {"num_items": 2},
             "labyrinth": {"size": 7}}
@@ -28,7 +28,7 @@ SIDES = {"on": {"flashes": True}, "off": {"flashes": False}, "default": {}}
 
 def steps_per_second(scenario: str, side: str, steps: int) -> float:
     kwargs = {**SETTINGS[scenario], **SIDES[side]}
-    rules, view = mjmaze.suite.make_rules(scenario, kwargs), mjmaze.suite.make_view(scenario, kwargs)
+    rules, view = mjmaze.backends.suite.make_rules(scenario, kwargs), mjmaze.backends.suite.make_view(scenario, kwargs)
     group = EnvGroup(rules, view, base.make_physics(rules, view), [0])
     frame = np.zeros((1, *view.frame_shape), np.uint8)
     group.reset([0])

@@ -18,7 +18,7 @@ import time
 import numpy as np
 
 import mjmaze
-from mjmaze import render
+from mjmaze.drawing import render
 
 
 def make_envs(count: int, own_contexts: bool):

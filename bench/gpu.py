@@ -109,7 +109,7 @@ def frames(device: str, quick: bool) -> dict:
     import torch
 
     import mjmaze
-    from mjmaze.warp import MazeBatchEnv
+    from mjmaze.backends.warp import MazeBatchEnv
 
     worlds, steps, every = (2, 6, 3) if quick else (8, 60, 10)
     results = {}
@@ -276,7 +276,7 @@ def _gl_renderer() -> str:
     NVIDIA's EGL), read with ``glGetString`` through libglvnd."""
     import ctypes
 
-    from mjmaze import render
+    from mjmaze.drawing import render
 
     render.gl_context()
     for library in ("libOpenGL.so.0", "libGL.so.1"):
@@ -360,8 +360,8 @@ def cpu_backend(quick: bool) -> dict:
 def paper_agents(device: str, quick: bool, paper_dir: str | None) -> dict:
     """The released agents on their test mazes, on the CPU backend and on the Warp backend."""
     import torch
-
-    from mjmaze.train import evaluate, paper_agents as released
+    from mjmaze.train import evaluate
+    from mjmaze.train import paper_agents as released
 
     num_envs, num_configs, plays = (4, 4, 1) if quick else (64, 64, 2)
     results = {}

@@ -30,12 +30,12 @@ import sys
 import tempfile
 import time
 
+import baseline
 import numpy as np
 
-import baseline
 import mjmaze
-from mjmaze import registry
-from mjmaze.vector import MazeVectorEnv
+from mjmaze.backends.vector import MazeVectorEnv
+from mjmaze.game import registry
 
 CORES = len(os.sched_getaffinity(0))
 

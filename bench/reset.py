@@ -19,9 +19,11 @@ import time
 import mujoco
 
 import mjmaze
-from mjmaze import configs, render, walls
-from mjmaze.arena import Arena
-from mjmaze.tasks import labyrinth
+from mjmaze.build import walls
+from mjmaze.build.arena import Arena
+from mjmaze.drawing import render
+from mjmaze.game import configs
+from mjmaze.scenarios import labyrinth
 
 
 def rss_mb() -> float:

@@ -24,9 +24,10 @@ import mujoco
 import numpy as np
 
 import mjmaze
-from mjmaze import mjcf, render
-from mjmaze.group import EnvGroup
-from mjmaze.tasks import base
+from mjmaze.backends import dm_task as base
+from mjmaze.backends.group import EnvGroup
+from mjmaze.build import mjcf
+from mjmaze.drawing import render
 
 
 def _lean_setup(size: int, style: str):
@@ -68,7 +69,7 @@ def bench_raw(size: int, steps: int, style: str) -> float:
 
 def bench_lean(size: int, steps: int, style: str) -> float:
     kwargs = {"size": size, "visual_style": style}
-    rules, view = mjmaze.suite.make_rules("labyrinth", kwargs), mjmaze.suite.make_view("labyrinth", kwargs)
+    rules, view = mjmaze.backends.suite.make_rules("labyrinth", kwargs), mjmaze.backends.suite.make_view("labyrinth", kwargs)
     group = EnvGroup(rules, view, base.make_physics(rules, view), [0])
     frame = np.empty((1, *view.frame_shape), np.uint8)
     actions = np.random.default_rng(0).integers(5, size=(steps, 1))
@@ -99,7 +100,7 @@ def bench_dm_control(size: int, steps: int, style: str) -> float:
 
 
 def bench_gymnasium(size: int, steps: int, style: str) -> float:
-    env = gymnasium.make(mjmaze.registry.get("labyrinth").gym_id, size=size, visual_style=style)
+    env = gymnasium.make(mjmaze.game.registry.get("labyrinth").gym_id, size=size, visual_style=style)
     actions = np.random.default_rng(0).integers(5, size=steps).tolist()
     env.reset(seed=0)
     start = time.perf_counter()

@@ -24,15 +24,15 @@ import sys
 import tempfile
 import time
 
+import baseline
 import numpy as np
 import torch
-from torch.nn import functional as F
-
-import baseline
 from mjmaze.train import a2c
 from mjmaze.train import settings as run_settings
 from mjmaze.train.model import Agent
-from mjmaze.vector import MazeVectorEnv
+from torch.nn import functional as F
+
+from mjmaze.backends.vector import MazeVectorEnv
 
 NUM_ENVS, NUM_STEPS = 16, 128
 

@@ -42,8 +42,8 @@ import numpy as np  # noqa: E402
 import torch  # noqa: E402
 import warp as wp  # noqa: E402
 
-from mjmaze import registry  # noqa: E402
-from mjmaze.warp import MazeBatchEnv  # noqa: E402
+from mjmaze.backends.warp import MazeBatchEnv  # noqa: E402
+from mjmaze.game import registry  # noqa: E402
 
 
 def _settings(names: list[str]) -> list[tuple[str, dict]]:

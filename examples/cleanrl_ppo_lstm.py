@@ -28,7 +28,7 @@ import mjmaze
 @dataclasses.dataclass
 class Args:
     scenario: str = "labyrinth"
-    """a registered scenario (mjmaze.registry.names())"""
+    """a registered scenario (mjmaze.game.registry.names())"""
     size: int = 5
     """Labyrinth's maze size"""
     seed: int = 1
@@ -85,9 +85,9 @@ def main(args: Args) -> list[float]:
     """Trains; returns the success (or the scenario's metric) of every episode that ended, in order."""
     torch.manual_seed(args.seed)
     kwargs = {"size": args.size} if args.scenario in ("labyrinth", "find_return") else {}
-    envs = gymnasium.make_vec(mjmaze.registry.get(args.scenario).gym_id, num_envs=args.num_envs,
+    envs = gymnasium.make_vec(mjmaze.game.registry.get(args.scenario).gym_id, num_envs=args.num_envs,
                               vectorization_mode="vector_entry_point", autoreset_mode="same_step", **kwargs)
-    metric = mjmaze.registry.get(args.scenario).metric
+    metric = mjmaze.game.registry.get(args.scenario).metric
     agent = Agent(envs.single_action_space.n)
     n, steps = args.num_envs, args.num_steps
     obs = torch.zeros((steps, n) + envs.single_observation_space.shape, dtype=torch.uint8)

@@ -5,7 +5,7 @@ Two front doors::
     env = mjmaze.load("labyrinth", task_kwargs={"size": 9})          # dm_control
     env = gymnasium.make(mjmaze.GYM_IDS["labyrinth"], size=9)       # gymnasium
 
-Importing mjmaze picks no GL backend: see :mod:`mjmaze.render` (``MUJOCO_GL``).
+Importing mjmaze picks no GL backend: see :mod:`mjmaze.drawing.render` (``MUJOCO_GL``).
 """
 
 from mjmaze import llvm_clash as _llvm_clash
@@ -23,12 +23,20 @@ with warnings.catch_warnings():
     warnings.filterwarnings("ignore", module="glfw")
     from dm_control import mujoco as _dm_mujoco  # noqa: F401
 
-from mjmaze import registry, versions  # noqa: E402
-from mjmaze.suite import ALL_TASKS, load, register, task_kwarg_names  # noqa: E402
+from mjmaze import moved as _moved  # noqa: E402
+from mjmaze.backends.suite import ALL_TASKS, load, register, task_kwarg_names  # noqa: E402
+from mjmaze.game import registry, versions  # noqa: E402
+
+_moved.install()  # the old module paths (mjmaze.vector, mjmaze.suite, ...) for one more release
 
 __all__ = ["ALL_TASKS", "GYM_IDS", "load", "register", "registry", "task_kwarg_names"]
 __version__ = versions.package_version()  # the latest release of the versions table (pyproject.toml says the same)
 
 #: scenario -> gymnasium id, for the scenarios that ship with mjmaze
-#: (``mjmaze.registry.get(name).gym_id`` for any registered one).
+#: (``mjmaze.game.registry.get(name).gym_id`` for any registered one).
 GYM_IDS = {name: registry.get(name).gym_id for name in ALL_TASKS}
+
+
+def __getattr__(name: str):
+    """``mjmaze.suite`` and the other modules' old names, for one more release (:mod:`mjmaze.moved`)."""
+    return _moved.attribute(name)

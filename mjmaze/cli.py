@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import argparse
 
-from mjmaze import registry
-from mjmaze.suite import DEFAULT_SCENARIO
+from mjmaze.backends.suite import DEFAULT_SCENARIO
+from mjmaze.game import registry
 
 
 def difficulty_arguments(parser: argparse.ArgumentParser) -> None:

@@ -22,7 +22,9 @@ import time
 import numpy as np
 
 import mjmaze
-from mjmaze import cli, core, files, suite, viz
+from mjmaze import cli, files, viz
+from mjmaze.backends import suite
+from mjmaze.game import core
 
 STEPS_PER_SECOND = core.STEPS_PER_SECOND
 KEY_LETTERS = "wasd"

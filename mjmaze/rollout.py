@@ -13,7 +13,9 @@ import time
 import numpy as np
 
 import mjmaze
-from mjmaze import cli, files, render, suite
+from mjmaze import cli, files
+from mjmaze.backends import suite
+from mjmaze.drawing import render
 
 
 def frame_strip(frames: list[np.ndarray], scale: int = 2, gap: int = 4) -> np.ndarray:

@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import argparse
 import math
-import re
 import pathlib
+import re
 from collections.abc import Sequence
 
 import numpy as np
@@ -24,8 +24,12 @@ try:
 except ImportError as error:  # pragma: no cover - depends on the install
     raise ImportError("mjmaze.viz needs Pillow: pip install 'mjmaze[viz]'") from error
 
-from mjmaze import cli, configs, core, files, mjcf, physics, render, suite
-from mjmaze.tasks import base
+from mjmaze import cli, files
+from mjmaze.backends import dm_task as base
+from mjmaze.backends import physics, suite
+from mjmaze.build import mjcf
+from mjmaze.drawing import render
+from mjmaze.game import configs, core
 
 PATH_COLOUR = (255, 255, 255)
 SPAWN_COLOUR = (255, 200, 0)

@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import math
 
+import fifth_scenario
 import numpy as np
 import pytest
 
 import mjmaze
-from mjmaze import maze, registry, suite
-
-import fifth_scenario
+from mjmaze.backends import suite
+from mjmaze.game import maze, registry
 
 # Registered before any test module is collected: every test parametrised over the registry runs it.
 suite.register(fifth_scenario.SCENARIO)

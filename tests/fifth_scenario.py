@@ -5,7 +5,8 @@ test that runs "every scenario" reads the registry and so runs this one too.
 
 from __future__ import annotations
 
-from mjmaze import configs, core, maze, mjcf, registry, rules
+from mjmaze.build import mjcf
+from mjmaze.game import configs, core, maze, registry, rules
 
 GOAL = mjcf.ObjectGeom("goal", "sphere", (0.15,), (1.0, 0.9, 0.0, 1.0), 0.3)
 

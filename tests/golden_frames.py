@@ -1,7 +1,7 @@
 """Golden frames: what each scenario's agent sees along scripted episodes, recorded once.
 
 The frame pipeline (GL's render, then Doom's light, sprites, head-bob and
-flashes: :mod:`mjmaze.look`) may be made faster but must draw the same
+flashes: :mod:`mjmaze.drawing.look`) may be made faster but must draw the same
 frames. These episodes are played from fixed seeds with fixed action
 sequences and cover what a frame can show: items and their animation frames,
 a flash after a pickup or a hit, the eye bobbing while walking, walls of both
@@ -20,7 +20,7 @@ import pathlib
 import numpy as np
 
 import mjmaze
-from mjmaze import batch, suite
+from mjmaze.backends import batch, suite
 
 PATH = pathlib.Path(__file__).parent / "data" / "golden_frames.npz"
 # (scenario, task arguments): each scenario at a paper difficulty.
@@ -36,7 +36,7 @@ STEPS = 120
 #: The steps whose frames are kept (0 is the reset's): Two-colour's scripts flash at 7, 14, 49 and 63
 #: (its damage every 8 steps, a pickup) and restart after 94 (env 1).
 KEPT = (0, 7, 14, 28, 49, 63, 84, 95, 112)
-# Actions 0-4: turn left, turn right, forward, forward+left, forward+right (mjmaze.core.ACTION_NAMES): a
+# Actions 0-4: turn left, turn right, forward, forward+left, forward+right (mjmaze.game.core.ACTION_NAMES): a
 # forward key 40% of the steps and turning right 55%, so the agent walks (head-bob), turns, meets walls and
 # reaches items. (Fixed with the reference frames: other weights would need a re-record.)
 _ACTION_WEIGHTS = (0.05, 0.55, 0.05, 0.175, 0.175)

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import mjmaze
-from mjmaze import suite
-from mjmaze.vector import MazeVectorEnv
+from mjmaze.backends import suite
+from mjmaze.backends.vector import MazeVectorEnv
 
 
 @pytest.fixture(params=mjmaze.ALL_TASKS)
@@ -173,7 +173,7 @@ def test_a_vector_env_refuses_bad_actions_with_one_clear_error(bad):
 
 def test_an_env_is_made_when_mujoco_misreads_its_xml_once(monkeypatch):
     # MuJoCo's XML reader can report "unknown error in attribute 'vertex'" for valid XML when an allocation
-    # left errno set (seen once on a GPU machine; mjmaze.arena.Arena.compile): the arena compiles once more.
+    # left errno set (seen once on a GPU machine; mjmaze.build.arena.Arena.compile): the arena compiles once more.
     compile_xml = mujoco.MjModel.from_xml_string
     calls = []
 

@@ -12,13 +12,15 @@ import warnings
 import gymnasium
 import numpy as np
 import pytest
+from fifth_scenario import SCENARIO
 from gymnasium.utils.env_checker import check_env
 
 import mjmaze
-from mjmaze import cli, configs, core, registry, suite
+from mjmaze import cli
 
 # The fifth scenario (tests/fifth_scenario.py), registered for every test by conftest.
-from fifth_scenario import SCENARIO
+from mjmaze.backends import suite
+from mjmaze.game import configs, core, registry
 
 
 def test_a_fifth_scenario_loads_and_plays():
@@ -53,8 +55,8 @@ def test_registering_a_clashing_scenario_is_one_clear_error():
         registry.get("doom")
 
 
-@pytest.mark.parametrize("module", ["mjmaze.registry", "mjmaze.configs", "mjmaze.layouts", "mjmaze.tasks.base",
-                                    "mjmaze.tasks.two_colour", "mjmaze.suite"])
+@pytest.mark.parametrize("module", ["mjmaze.game.registry", "mjmaze.game.configs", "mjmaze.game.layouts", "mjmaze.backends.dm_task",
+                                    "mjmaze.scenarios.two_colour", "mjmaze.backends.suite"])
 @pytest.mark.slow
 def test_every_module_imports_first(module):
     # An import cycle shows as an ImportError when the wrong module comes first.

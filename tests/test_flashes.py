@@ -9,12 +9,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import TURN_LEFT, place
 
 import mjmaze
-from mjmaze import look
-from mjmaze.tasks import two_colour
-
-from conftest import TURN_LEFT, place
+from mjmaze.drawing import look
+from mjmaze.scenarios import two_colour
 
 
 def twins(name, **kwargs):

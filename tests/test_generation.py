@@ -9,8 +9,9 @@ import numpy as np
 import pytest
 
 import mjmaze
-from mjmaze import configs, maze, suite
-from mjmaze.tasks import labyrinth
+from mjmaze.backends import suite
+from mjmaze.game import configs, maze
+from mjmaze.scenarios import labyrinth
 
 SPEC9 = configs.LayoutSpec(9, 1.0, 0.6, num_objects=1)
 

@@ -5,11 +5,11 @@ tolerance below changes what agents see: bump the ids and re-run the paper
 agents (docs/architecture.md's checklist), then record anew.
 """
 
+import golden_frames as golden
 import numpy as np
 import pytest
 
-import golden_frames as golden
-from mjmaze.vector import MazeVectorEnv
+from mjmaze.backends.vector import MazeVectorEnv
 
 MAX_DIFFERENCE = 2  # grey levels, any pixel's channel
 MEAN_DIFFERENCE = 0.25  # grey levels over a frame

@@ -12,8 +12,11 @@ import math
 import numpy as np
 import pytest
 
-from mjmaze import doom, look, mjcf, suite
-from mjmaze.tasks import base
+from mjmaze.backends import dm_task as base
+from mjmaze.backends import suite
+from mjmaze.build import mjcf
+from mjmaze.drawing import look
+from mjmaze.game import doom
 
 # Actions as ViZDoom played them: forward 12 steps, nothing 8, forward 15, nothing 10.
 HELD = [1] * 12 + [0] * 8 + [1] * 15 + [0] * 10

@@ -4,12 +4,12 @@ import math
 
 import numpy as np
 import pytest
+from conftest import FORWARD, TURN_LEFT, TURN_RIGHT, find_cell, place
 
 import mjmaze
-from mjmaze import core, doom, physics
-from mjmaze.tasks import labyrinth
-
-from conftest import FORWARD, TURN_LEFT, TURN_RIGHT, find_cell, place
+from mjmaze.backends import physics
+from mjmaze.game import core, doom
+from mjmaze.scenarios import labyrinth
 
 
 def test_exit_pays_one_and_ends_the_episode(labyrinth9):

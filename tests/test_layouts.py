@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import mjmaze
-from mjmaze import layouts
-from mjmaze.tasks import k_item
+from mjmaze.game import layouts
+from mjmaze.scenarios import k_item
 
 UNITS = 128  # Doom map units per metre
 

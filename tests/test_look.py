@@ -9,19 +9,21 @@ import math
 import subprocess
 import sys
 
+import golden_frames as golden
 import mujoco
 import numpy as np
 import pytest
+from conftest import place
 
 import mjmaze
-
-from mjmaze import compiled_light, look, mjcf, palette, sprites, suite, viz
-from mjmaze.doom import FIRST_OBSERVATION_TIC
-from mjmaze.group import EnvGroup
-from mjmaze.tasks import base, k_item, labyrinth, two_colour
-
-import golden_frames as golden
-from conftest import place
+from mjmaze import viz
+from mjmaze.backends import dm_task as base
+from mjmaze.backends import suite
+from mjmaze.backends.group import EnvGroup
+from mjmaze.build import mjcf, palette, sprites
+from mjmaze.drawing import compiled_light, look
+from mjmaze.game.doom import FIRST_OBSERVATION_TIC
+from mjmaze.scenarios import k_item, labyrinth, two_colour
 
 # Mean colour tolerance per channel, in grey levels (0-255).
 CLOSE = 9
@@ -99,7 +101,7 @@ def test_a_wall_seen_along_a_corridor_is_lit_by_its_depth_as_in_vizdoom():
 
 def test_dooms_light_never_takes_a_colour_past_white():
     # GL draws every surface by ambient light alone, at most 255 x AMBIENT; Doom's
-    # light multiplies that without clipping (mjmaze.look.DoomLight): a gain above
+    # light multiplies that without clipping (mjmaze.drawing.look.DoomLight): a gain above
     # 1 / AMBIENT would wrap a bright pixel round to black.
     assert look.light_table().max() * 255 * palette.AMBIENT < 255.5
 
@@ -544,7 +546,7 @@ def test_the_compiled_light_gives_the_numpy_lights_frames_bit_for_bit(scenario, 
 
 _LIGHT_THEN_GL = """
 import numpy as np
-from mjmaze import compiled_light, look
+from mjmaze.drawing import compiled_light, look
 light = look.DoomLight(np, "cpu", 112, 64, 5, 1.0)
 assert light._compiled is not None
 light(np.zeros((1, 64, 112, 3), np.uint8), np.full((1, 64, 112), 0.5, np.float32), np.zeros((1, 3)), np.zeros(1))
@@ -555,7 +557,7 @@ _GL_THEN_LIGHT = """
 import mjmaze
 env = mjmaze.load("labyrinth", task_kwargs={"size": 5})
 env.reset()
-from mjmaze import compiled_light
+from mjmaze.drawing import compiled_light
 compiled_light._compiled().recompile()  # compiled now, with Mesa's LLVM loaded
 print(env.step(2).observation["pixels"].mean() > 0)
 """

@@ -9,7 +9,6 @@ import shutil
 import numpy as np
 import pytest
 import torch
-
 from mjmaze.train import analysis, evaluate, paper_agents, policy, record
 from mjmaze.train.model import Agent
 
@@ -143,8 +142,9 @@ def test_curves_draw_a_paper_agents_level_beside_runs(released, tmp_path):
 
 
 def test_the_table_plays_again_an_evaluation_made_with_an_older_env_version(monkeypatch, tmp_path):
-    from mjmaze import registry
     from mjmaze.train import paper_table
+
+    from mjmaze.game import registry
 
     monkeypatch.chdir(tmp_path)
     played = []

@@ -8,11 +8,11 @@ import sys
 import numpy as np
 import pytest
 
-from mjmaze import render
+from mjmaze.drawing import render
 
 _RENDER_ONE = """
 import json, numpy as np, mjmaze
-from mjmaze import render
+from mjmaze.drawing import render
 env = mjmaze.load("labyrinth", task_kwargs={{"size": 7, "random": 0}})
 frames = [env.reset().observation["pixels"]] + [env.step(a).observation["pixels"] for a in (0, 0, 2, 2)]
 np.save({path!r}, np.stack(frames))

@@ -11,10 +11,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
-from mjmaze import look, rules, suite
-
 from conftest import SMALL_SETTINGS
+
+from mjmaze.backends import suite
+from mjmaze.drawing import look
+from mjmaze.game import rules
 
 torch = pytest.importorskip("torch")
 

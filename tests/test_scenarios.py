@@ -4,13 +4,13 @@ import math
 
 import numpy as np
 import pytest
-
-import mjmaze
-from mjmaze import core, doom, suite
-from mjmaze.tasks import k_item, two_colour
+from conftest import FORWARD, TURN_LEFT, place
 from mjmaze.train import published
 
-from conftest import FORWARD, TURN_LEFT, place
+import mjmaze
+from mjmaze.backends import suite
+from mjmaze.game import core, doom
+from mjmaze.scenarios import k_item, two_colour
 
 STEP = -0.0004
 

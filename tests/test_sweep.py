@@ -12,16 +12,15 @@ import time
 
 import pytest
 import torch
+from mjmaze.train import published, report, sweep
 
 import mjmaze
-
-from mjmaze.train import published, report, sweep
 
 
 def test_the_paper_grid_is_table_2():
     runs = sweep.grid("paper")
     assert len(runs) == 48 and len({r.name for r in runs}) == 48
-    assert sorted({(r.scenario, r.difficulty) for r in runs}) == sorted((s.name, d) for s in mjmaze.registry.all_scenarios() for d in published.of(s.name).results)
+    assert sorted({(r.scenario, r.difficulty) for r in runs}) == sorted((s.name, d) for s in mjmaze.game.registry.all_scenarios() for d in published.of(s.name).results)
     assert {r.seed for r in runs} == {0, 1, 2}
 
 

@@ -1,18 +1,17 @@
 """The A2C baseline: returns and losses by hand, a smoke run, checkpoints, resume, evaluation."""
 
 import json
-import pathlib
 import math
+import pathlib
 import re
 
 import pytest
 import torch
+from mjmaze.train import a2c, checkpoint, evaluate, policy
+from mjmaze.train import settings as run_settings
+from mjmaze.train.model import Agent
 
 import mjmaze
-
-from mjmaze.train import settings as run_settings
-from mjmaze.train import a2c, checkpoint, evaluate, policy
-from mjmaze.train.model import Agent
 
 
 def test_n_step_returns_match_a_hand_computation():
@@ -330,7 +329,7 @@ def test_a_killed_env_worker_costs_the_run_nothing_but_its_rollout(tmp_path):
 
 @pytest.mark.slow
 def test_workers_that_keep_dying_end_in_a_checkpoint_and_one_line(tmp_path, monkeypatch):
-    from mjmaze import vector
+    from mjmaze.backends import vector
 
     calls = {"n": 0}
     real_step = vector.MazeVectorEnv.step

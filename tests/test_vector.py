@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 import mjmaze
-
-from mjmaze import registry, suite
-from mjmaze.tasks import labyrinth
-from mjmaze.vector import SHARED_MEMORY_PREFIX, MazeVectorEnv, WorkerError
+from mjmaze.backends import suite
+from mjmaze.backends.vector import SHARED_MEMORY_PREFIX, MazeVectorEnv, WorkerError
+from mjmaze.game import registry
+from mjmaze.scenarios import labyrinth
 
 
 class FailingLabyrinth(labyrinth.Labyrinth):
@@ -182,7 +182,7 @@ def test_close_ends_the_workers_and_frees_shared_memory():
 
 _HOLD_A_VECTOR_ENV = """
 import time
-from mjmaze.vector import MazeVectorEnv
+from mjmaze.backends.vector import MazeVectorEnv
 envs = MazeVectorEnv(2, "labyrinth", size=5, num_workers=2)
 envs.reset(seed=0)
 print("ready", flush=True)
@@ -255,7 +255,7 @@ import numpy as np
 import torch  # what a training script brings
 if __name__ != "__main__":  # re-imported by a worker
     pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else os.environ["MARKER"]).write_text("imported")
-from mjmaze.vector import MazeVectorEnv
+from mjmaze.backends.vector import MazeVectorEnv
 if __name__ == "__main__":
     envs = MazeVectorEnv(2, "labyrinth", size=5, step_in_caller=False)
     envs.reset(seed=0)

@@ -1,4 +1,4 @@
-"""The ids' versions are data (mjmaze.versions): the registry, the Version Histories, CHANGELOG.md,
+"""The ids' versions are data (mjmaze.game.versions): the registry, the Version Histories, CHANGELOG.md,
 the package version and the rest of the tree agree with the table, and releases bump each id once."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import re
 import pytest
 
 import mjmaze
-from mjmaze import registry, versions
+from mjmaze.game import registry, versions
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 RELEASED = [name for name, date in versions.RELEASES if date]
@@ -59,10 +59,10 @@ def test_changes_are_in_order_and_in_known_releases():
 
 @pytest.mark.parametrize("scenario", mjmaze.ALL_TASKS)
 def test_each_scenario_docstring_ends_with_its_version_history(scenario):
-    module = importlib.import_module(f"mjmaze.tasks.{scenario}")
+    module = importlib.import_module(f"mjmaze.scenarios.{scenario}")
     id_name = registry.get(scenario).gym_id.rsplit("-v", 1)[0]
     history = versions.version_history(id_name)
-    assert module.__doc__.endswith("Version History\n    (from :mod:`mjmaze.versions`, newest first)\n" + history)
+    assert module.__doc__.endswith("Version History\n    (from :mod:`mjmaze.game.versions`, newest first)\n" + history)
     bullets = history.splitlines()
     assert bullets[0].startswith(f"    * v{versions.version(id_name)} (") and bullets[-1].startswith("    * v0 (")
 
@@ -82,7 +82,7 @@ def test_the_package_version_is_the_latest_release():
     assert pyproject == mjmaze.__version__ == versions.package_version() == RELEASED[-1]
 
 
-# Where a current id may be written out: the table (mjmaze.versions, which writes none),
+# Where a current id may be written out: the table (mjmaze.game.versions, which writes none),
 # the history (CHANGELOG.md, docs/notes/) and the README (whose snippets tests/test_readme.py runs).
 _MAY_NAME_CURRENT_IDS = ("CHANGELOG.md", "README.md", "docs/notes/")
 _TEXT = {".py", ".md", ".toml", ".cfg", ".txt", ".yml", ".yaml", ".json", ""}
@@ -100,7 +100,7 @@ def _tree_files():
 
 def test_no_current_id_is_written_out_elsewhere():
     # Tests, tools and docs name the current ids through the registry (mjmaze.GYM_IDS): a bump
-    # is then one line in mjmaze.versions, not a hunt through the tree.
+    # is then one line in mjmaze.game.versions, not a hunt through the tree.
     current = re.compile(r"\b(" + "|".join(f"{n.split('/')[1]}-v{versions.version(n)}" for n in versions.id_names())
                          + r")\b")
     found = []

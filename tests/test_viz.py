@@ -10,7 +10,8 @@ import pytest
 from conftest import find_cell, open_run, place
 
 import mjmaze
-from mjmaze import doom, maze, play, viz
+from mjmaze import play, viz
+from mjmaze.game import doom, maze
 
 
 @pytest.fixture

@@ -9,11 +9,11 @@ import pathlib
 
 import numpy as np
 import pytest
-
-from mjmaze import vizdoom_env
-from mjmaze.doom import TICS_PER_STEP
 from mjmaze.train import a2c, evaluate
 from mjmaze.train.settings import Args
+
+from mjmaze.backends import vizdoom_env
+from mjmaze.game.doom import TICS_PER_STEP
 
 RELEASED = pathlib.Path(__file__).parent / "data" / "released"
 FORWARD, TURN_LEFT = 2, 0

@@ -14,23 +14,25 @@ import gymnasium
 import mujoco
 import numpy as np
 import pytest
+from conftest import SMALL_SETTINGS
 from torch.overrides import TorchFunctionMode
 
 import mjmaze
-from mjmaze import core, look, mjcf, registry, suite
-
-from conftest import SMALL_SETTINGS
+from mjmaze.backends import suite
+from mjmaze.build import mjcf
+from mjmaze.drawing import look
+from mjmaze.game import core, registry
 
 pytestmark = [pytest.mark.warp, pytest.mark.slow]
 torch = pytest.importorskip("torch")
 pytest.importorskip("mujoco_warp")
-from mjmaze import warp as mjwarp  # noqa: E402
+from mjmaze.backends import warp as mjwarp  # noqa: E402
 
 SETTINGS = SMALL_SETTINGS
 SEED = 7
 # Frames of the same pose: Warp's ray tracer filters textures where GL samples
 # the nearest texel; both draw the scene by ambient light and apply Doom's light
-# the same way (mjmaze.look.DoomLight). Measured: under 4.
+# the same way (mjmaze.drawing.look.DoomLight). Measured: under 4.
 MAX_MEAN_COLOUR_DIFFERENCE = 8  # of 255, per channel, over a frame
 MIN_SEGMENTATION_AGREEMENT = 0.95
 

@@ -1,4 +1,4 @@
-"""Prints CHANGELOG.md's id lines of every release, from the versions table (``mjmaze.versions``).
+"""Prints CHANGELOG.md's id lines of every release, from the versions table (``mjmaze.game.versions``).
 
     python tools/changelog_ids.py            # paste a release's lines into its CHANGELOG.md section
 
@@ -7,7 +7,7 @@ tests/test_versions.py checks that CHANGELOG.md holds them.
 
 from __future__ import annotations
 
-from mjmaze import versions
+from mjmaze.game import versions
 
 
 def main() -> None:

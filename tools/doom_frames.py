@@ -7,7 +7,7 @@
     python tools/doom_frames.py --armour-parts  # the armours' coloured parts over their blink, 1-4 m ahead (Two-colour's items)
     python tools/doom_frames.py --projection    # ViZDoom's focal lengths across and down, beside mjmaze's
     python tools/doom_frames.py --light         # Doom's light over depth: both walls' sides, floor, ceiling
-    python tools/doom_frames.py --sprite-light --freedoom paper  # the items' colormap over depth (mjmaze.sprites)
+    python tools/doom_frames.py --sprite-light --freedoom paper  # the items' colormap over depth (mjmaze.build.sprites)
     python tools/doom_frames.py --two-colour RELEASED_REPO/scenarios/basefiles/two_color_basefile.wad
                                             # the released Two-colour script played: health changes, tics survived
     python tools/doom_frames.py --calibrate --freedoom paper  # ... with the paper's Freedoom 0.10.1
@@ -26,7 +26,7 @@ units up, the sector at UDMF's default light (160, none is set), things by the
 released type numbers. ViZDoom draws it with the released settings (320x180,
 the pistol shown, no HUD) and the released env's area resize to 112x64.
 ``--calibrate`` prints ViZDoom's mean colours beside mjmaze's: where
-``mjmaze.palette``'s rooms and the scenarios' object colours come from
+``mjmaze.build.palette``'s rooms and the scenarios' object colours come from
 (docs/look.md), and what ``tests/test_look.py`` holds.
 """
 
@@ -42,10 +42,15 @@ import imageio.v3 as iio
 import numpy as np
 
 import mjmaze
-from mjmaze import configs, look, maze, mjcf, palette, sprites, suite, vizdoom_env, walls
-from mjmaze.tasks import base, find_return, k_item, two_colour
+from mjmaze.backends import dm_task as base
+from mjmaze.backends import suite, vizdoom_env
+from mjmaze.build import mjcf, palette, sprites, walls
+from mjmaze.drawing import look
+from mjmaze.game import configs, maze
 
 #: The game data ViZDoom draws with (``--freedoom``): None, the installed ViZDoom's own.
+from mjmaze.scenarios import find_return, k_item, two_colour
+
 GAME_WAD: str | None = None
 
 UNITS = 128  # Doom map units per metre (mjmaze's 1 m cell is the generator's 128 units)
@@ -356,7 +361,7 @@ def projection() -> None:
     Down: the rows a wall 2 and 3 m ahead spans (between the slime room's blue
     ceiling and green floor) against its 128 units. Across: the centre column of
     a tall red column 1-2 m off the view axis. mjmaze's are its camera's focal
-    lengths at the same frame (``mjmaze.mjcf.set_ego_projection``).
+    lengths at the same frame (``mjmaze.build.mjcf.set_ego_projection``).
     """
     env = empty_arena("slime", pistol=False)
     config = env.task.config
@@ -388,7 +393,7 @@ def projection() -> None:
 
 
 def light() -> None:
-    """Prints Doom's light over depth in the stone room, ViZDoom | mjmaze: ``mjmaze.palette``'s ``DepthLight`` curves.
+    """Prints Doom's light over depth in the stone room, ViZDoom | mjmaze: ``mjmaze.build.palette``'s ``DepthLight`` curves.
 
     Walls: the frame's centre facing a north-south wall (the room's east
     side) and an east-west one (its north side) head-on, ``depth`` metres
@@ -597,7 +602,7 @@ def two_colour_script(basefile: pathlib.Path, episodes: int = 32, complexity: in
     it with frame skip 4, as an env step. Prints every change of health by its
     size (lava 8, a right item +25 up to the cap, wrong ones 25 less what the
     armour picked up absorbs) and the tics survived: the figures
-    ``mjmaze.tasks.two_colour`` holds, and a random policy's level in ViZDoom.
+    ``mjmaze.scenarios.two_colour`` holds, and a random policy's level in ViZDoom.
     """
     import collections
 

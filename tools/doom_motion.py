@@ -6,7 +6,7 @@
 Plays the same key sequences (frame skip 4) in ViZDoom's open `health_gathering`
 room and in an empty mjmaze arena (Two-colour at complexity 0) and prints, per
 agent step, the distance moved (Doom map units, 1/128 m) and the turn (degrees).
-These figures are where `mjmaze.tasks.base`'s motion constants come from and
+These figures are where `mjmaze.backends.dm_task`'s motion constants come from and
 what `tests/test_labyrinth.py` checks (docs/motion.md).
 """
 
@@ -19,7 +19,7 @@ import pathlib
 import tempfile
 
 import mjmaze
-from mjmaze import doom
+from mjmaze.game import doom
 
 # Key sequences as indices of the default action set: 0 left, 1 right, 2 forward, 3 forward+left.
 SEQUENCES = {
@@ -78,9 +78,8 @@ def wall_slide(angles=(20, 45, 70), steps: int = 12) -> None:
     units away: per agent step, the distance along the wall (units) and how far the agent got toward
     it, in both engines. The arena is laid out as the released generators lay out theirs
     (``doom_frames.textmap``: the outer wall is the sector's edge)."""
-    import vizdoom as vzd
-
     import doom_frames  # tools/, beside this script
+    import vizdoom as vzd
 
     env = doom_frames.empty_arena("stone")
     config, physics = env.task.config, env.physics

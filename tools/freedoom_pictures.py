@@ -7,9 +7,9 @@
 The paper's agents saw Freedoom 0.10.1 (``tools/paper_agents_vizdoom.py``
 fetches its ``freedoom2.wad`` and checks it). mjmaze ships only the pictures
 of the eight things the released generators place as items, every frame of
-their animations (:data:`mjmaze.sprites.SPRITES`), the patches of the
+their animations (:data:`mjmaze.build.sprites.SPRITES`), the patches of the
 released walls' texture and the released floors' and ceilings' flats
-(:data:`mjmaze.sprites.WALL_TEXTURES`, :data:`mjmaze.sprites.FLATS`), the
+(:data:`mjmaze.build.sprites.WALL_TEXTURES`, :data:`mjmaze.build.sprites.FLATS`), the
 palette and the colormaps (Doom's light), copied byte for byte into a small
 PWAD, with Freedoom's licence beside it. ``--check`` also compares each wall
 texture's composition with Freedoom's ``TEXTURE1``.
@@ -24,7 +24,8 @@ import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
-from mjmaze import files, sprites  # noqa: E402
+from mjmaze import files  # noqa: E402
+from mjmaze.build import sprites
 
 TARGET = pathlib.Path(__file__).resolve().parent.parent / "mjmaze" / "freedoom" / sprites.FREEDOOM_WAD
 
@@ -43,7 +44,7 @@ def wanted_lumps(source: dict[str, bytes]) -> dict[str, bytes]:
 
 
 def texture_compositions(source: dict[str, bytes]) -> dict[str, tuple]:
-    """Each of :data:`mjmaze.sprites.WALL_TEXTURES` as ``source``'s ``PNAMES`` and ``TEXTURE1`` compose it."""
+    """Each of :data:`mjmaze.build.sprites.WALL_TEXTURES` as ``source``'s ``PNAMES`` and ``TEXTURE1`` compose it."""
     pnames, textures = source["PNAMES"], source["TEXTURE1"]
     names = [pnames[4 + 8 * i : 12 + 8 * i].rstrip(b"\0").decode().upper() for i in range(struct.unpack("<i", pnames[:4])[0])]
     count = struct.unpack("<i", textures[:4])[0]
@@ -92,7 +93,7 @@ def main() -> None:
     if args.figure:
         figure(args.figure)
         return
-    from mjmaze import vizdoom_env
+    from mjmaze.backends import vizdoom_env
 
     try:
         source = vizdoom_env.freedoom_path(args.freedoom)
@@ -104,7 +105,7 @@ def main() -> None:
         same = TARGET.exists() and TARGET.read_bytes() == data
         print(f"{TARGET}: {'the same as' if same else 'DIFFERS from'} the pictures in {source}")
         composed = texture_compositions(lumps) == sprites.WALL_TEXTURES
-        print(f"mjmaze.sprites.WALL_TEXTURES: {'as' if composed else 'NOT as'} {source}'s TEXTURE1 composes them")
+        print(f"mjmaze.build.sprites.WALL_TEXTURES: {'as' if composed else 'NOT as'} {source}'s TEXTURE1 composes them")
         raise SystemExit(0 if same and composed else 1)
     files.atomic_write_bytes(TARGET, data)
     print(f"wrote {TARGET} ({len(data)} bytes) from {source}")

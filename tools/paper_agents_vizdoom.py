@@ -45,18 +45,22 @@ import pathlib
 
 import numpy as np
 import torch
-
-from mjmaze import files, rules, sprites, suite
-from mjmaze.doom import FIRST_OBSERVATION_TIC, MAP_UNIT, TICS_PER_STEP
-from mjmaze.tasks import two_colour
 from mjmaze.train import paper_agents
+
+from mjmaze import files
+from mjmaze.backends import suite
+
 # The engine adapter that mjmaze's training and evaluation play ViZDoom through: one copy of how the
 # released env set a game up, drew its frame and paid its metric.
-from mjmaze.vizdoom_env import FRAME_SIZE as SIZE
-from mjmaze.vizdoom_env import LIMITED_ACTIONS, episode_metrics, freedoom_path
-from mjmaze.vizdoom_env import frame as _frame
-from mjmaze.vizdoom_env import maze_seed as _maze_seed
-from mjmaze.vizdoom_env import released_game as _game
+from mjmaze.backends.vizdoom_env import FRAME_SIZE as SIZE
+from mjmaze.backends.vizdoom_env import LIMITED_ACTIONS, episode_metrics, freedoom_path
+from mjmaze.backends.vizdoom_env import frame as _frame
+from mjmaze.backends.vizdoom_env import maze_seed as _maze_seed
+from mjmaze.backends.vizdoom_env import released_game as _game
+from mjmaze.build import sprites
+from mjmaze.game import rules
+from mjmaze.game.doom import FIRST_OBSERVATION_TIC, MAP_UNIT, TICS_PER_STEP
+from mjmaze.scenarios import two_colour
 
 _POSE = ("POSITION_X", "POSITION_Y", "ANGLE")
 PLAYS_PER_MAZE = 2
@@ -157,8 +161,7 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
     import vizdoom as vzd
 
     import mjmaze
-
-    from mjmaze.tasks.two_colour import SPAWN_EVERY_TICS as every
+    from mjmaze.scenarios.two_colour import SPAWN_EVERY_TICS as every
 
     info = paper_agents.get(name)
     two_colour = info.scenario == "two_colour"
@@ -464,9 +467,9 @@ def picks(name: str, checkout: str, mazes: int = 32, wad: str | None = None) -> 
     totem's spot) and ``all``: episodes, mean tics, right and wrong per 100 tics.
     """
     import vizdoom as vzd
+    from mjmaze.train import policy
 
     import mjmaze
-    from mjmaze.train import policy
 
     info = paper_agents.get(name)
     if info.scenario != "two_colour":
@@ -539,7 +542,7 @@ def blink(name: str, checkout: str, mazes: int = 8, steps: int = 300, wad: str |
     is sorted into its sector-lit picture or its fullbright one by which one's
     colours at that depth (``sprites.colormap_of_depth``) its drawn mean is
     nearer. mjmaze: each sprite in view (its segmentation) by the animation
-    frame :class:`mjmaze.look.SpriteView` gives it. Returns, per engine and
+    frame :class:`mjmaze.drawing.look.SpriteView` gives it. Returns, per engine and
     Doom name: sightings and the share of them bright.
     """
     import math

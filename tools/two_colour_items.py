@@ -16,12 +16,11 @@ import sys
 
 import numpy as np
 import torch
-
-import mjmaze
-from mjmaze import core
-from mjmaze.tasks import two_colour
 from mjmaze.train import policy
 
+import mjmaze
+from mjmaze.game import core
+from mjmaze.scenarios import two_colour
 
 TURN_LEFT, TURN_RIGHT, FORWARD, FORWARD_LEFT, FORWARD_RIGHT = (
     core.ACTION_NAMES.index(name) for name in ("turn_left", "turn_right", "forward", "forward_left", "forward_right"))

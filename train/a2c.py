@@ -34,8 +34,10 @@ import torch
 import tyro
 from torch.nn import functional as F
 
-from mjmaze import files, suite
-from mjmaze.vector import WorkerError, make_vector_env
+from mjmaze import files
+from mjmaze.backends import suite
+from mjmaze.backends import make_vector_env
+from mjmaze.backends.vector import WorkerError
 
 from . import checkpoint, published
 from .model import Agent
@@ -120,7 +122,7 @@ def train(args: Args) -> pathlib.Path:
 def training_envs(args: Args, device: torch.device) -> functools.partial:
     """What makes the run's training envs (again, when a worker dies): same-step autoreset, the train split."""
     if args.engine == "vizdoom":
-        from mjmaze import vizdoom_env
+        from mjmaze.backends import vizdoom_env
 
         return functools.partial(
             vizdoom_env.make_vector_env, args.num_envs, args.scenario, args.difficulty_value(), split="train",

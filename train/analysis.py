@@ -37,7 +37,8 @@ import numpy as np
 from matplotlib.figure import Figure
 
 import mjmaze
-from mjmaze import files, suite
+from mjmaze import files
+from mjmaze.backends import suite
 
 from . import checkpoint, policy, published
 from .settings import using_torch_threads

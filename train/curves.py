@@ -27,7 +27,8 @@ import numpy as np
 from matplotlib.figure import Figure
 from tqdm import tqdm
 
-from mjmaze import core, files, registry
+from mjmaze import files
+from mjmaze.game import core, registry
 
 from . import checkpoint, evaluate, paper_agents, published
 from .analysis import save_figure

@@ -25,7 +25,8 @@ import warnings
 
 import numpy as np
 
-from mjmaze import files, registry
+from mjmaze import files
+from mjmaze.game import registry
 
 from . import checkpoint, curves, published
 from .analysis import save_figure

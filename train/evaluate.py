@@ -24,8 +24,10 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
-from mjmaze import cli, files, suite
-from mjmaze.vector import MazeVectorEnv, make_vector_env
+from mjmaze import cli, files
+from mjmaze.backends import suite
+from mjmaze.backends import make_vector_env
+from mjmaze.backends.vector import MazeVectorEnv
 
 from . import checkpoint, policy, published
 from .model import Agent
@@ -61,8 +63,8 @@ def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, devic
     it, as in training), or uniformly random ones for ``agent=None``. ``seed`` seeds the envs (the episodes' random draws:
     spawn headings, items) and the random actions. ``layouts``: a folder of
     released mazes to play instead of the split's generated ones. ``backend``:
-    ``"cpu"`` (:class:`~mjmaze.vector.MazeVectorEnv`) or ``"warp"`` (every env in one
-    MuJoCo Warp model on ``device``: :class:`mjmaze.warp.MazeBatchEnv`).
+    ``"cpu"`` (:class:`~mjmaze.backends.vector.MazeVectorEnv`) or ``"warp"`` (every env in one
+    MuJoCo Warp model on ``device``: :class:`mjmaze.backends.warp.MazeBatchEnv`).
     """
     num_configs = check_sizes(num_envs, num_configs, plays_per_config)
     # Env i starts at configuration i * 64 / num_envs and cycles, so its first
@@ -73,7 +75,7 @@ def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, devic
     if layouts is not None:
         task_kwargs["layouts"] = layouts
     if args.engine == "vizdoom":  # the released setting's first num_configs mazes of the split, in ViZDoom
-        from mjmaze import vizdoom_env
+        from mjmaze.backends import vizdoom_env
 
         envs = vizdoom_env.make_vector_env(
             num_envs, args.scenario, args.difficulty_value(), split=split, released_dir=args.released_dir,

@@ -29,7 +29,8 @@ import argparse
 import dataclasses
 import time
 
-from mjmaze import files, registry
+from mjmaze import files
+from mjmaze.game import registry
 
 from . import a2c, curves, evaluate, policy, record
 from .settings import Args

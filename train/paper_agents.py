@@ -39,7 +39,9 @@ import urllib.request
 
 import torch
 
-from mjmaze import files, registry, vizdoom_env
+from mjmaze import files
+from mjmaze.backends import vizdoom_env
+from mjmaze.game import registry
 
 from .model import Agent
 from .settings import Args

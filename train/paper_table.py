@@ -35,7 +35,8 @@ import pathlib
 
 import numpy as np
 
-from mjmaze import files, registry
+from mjmaze import files
+from mjmaze.game import registry
 
 from . import evaluate, paper_agents, published
 from .settings import INFERENCE_THREADS

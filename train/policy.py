@@ -19,11 +19,12 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
-from mjmaze import cli, suite, viz
+from mjmaze import cli, viz
+from mjmaze.backends import suite
 
 from . import checkpoint, paper_agents
-from .settings import INFERENCE_THREADS, Args
 from .model import Agent
+from .settings import INFERENCE_THREADS, Args
 
 RANDOM = "random"
 

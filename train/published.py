@@ -1,6 +1,6 @@
 """What the paper published of each scenario, and how mjmaze's tables and plots show it.
 
-An env needs none of this (:class:`mjmaze.registry.Scenario` holds what it
+An env needs none of this (:class:`mjmaze.game.registry.Scenario` holds what it
 needs); the reports (:mod:`mjmaze.train.report`, :mod:`mjmaze.train.paper_table`),
 the curves (:mod:`mjmaze.train.curves`), the sweep's grid (:mod:`mjmaze.train.sweep`)
 and the analysis (:mod:`mjmaze.train.analysis`) read it here. A scenario the paper
@@ -12,7 +12,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Mapping
 
-from mjmaze import registry
+from mjmaze.game import registry
 
 #: Agent steps at which the paper's curves were read (its plots' 10M, 20M, 40M,
 #: 100M, 200M and 800M frames).

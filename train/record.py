@@ -22,7 +22,9 @@ import numpy as np
 from tqdm import tqdm
 
 import mjmaze
-from mjmaze import core, files, suite, viz
+from mjmaze import files, viz
+from mjmaze.backends import suite
+from mjmaze.game import core
 
 from . import checkpoint, policy
 from .settings import using_torch_threads

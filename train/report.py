@@ -27,7 +27,9 @@ import pathlib
 
 import numpy as np
 
-from mjmaze import files, registry, suite
+from mjmaze import files
+from mjmaze.backends import suite
+from mjmaze.game import registry
 
 from . import curves, published
 

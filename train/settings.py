@@ -13,7 +13,9 @@ from typing import Annotated
 import torch
 import tyro
 
-from mjmaze import cli, registry, suite
+from mjmaze import cli
+from mjmaze.backends import BACKENDS, suite
+from mjmaze.game import registry
 
 
 @dataclasses.dataclass
@@ -21,7 +23,7 @@ class _RunSettings:
     """Train the paper's A2C baseline on one mjmaze scenario."""
 
     scenario: str = suite.DEFAULT_SCENARIO
-    """a registered scenario (mjmaze.registry.names(): labyrinth, find_return, k_item, two_colour, ...)"""
+    """a registered scenario (mjmaze.game.registry.names(): labyrinth, find_return, k_item, two_colour, ...)"""
     num_configs: int | None = None
     """training configurations (None: 256; the paper's study: 16, 64, 256, 1024)"""
     total_steps: int = 10_000_000
@@ -63,7 +65,7 @@ class _RunSettings:
     freedoom: str = "paper"
     """with --engine vizdoom: the game data: paper (Freedoom 0.10.1, fetched once), vizdoom (ViZDoom's own) or a freedoom2.wad"""
     cuda_graph: bool = False
-    """with --backend warp on a GPU: replay each env step as one CUDA graph (mjmaze.warp.MazeBatchEnv's cuda_graph)"""
+    """with --backend warp on a GPU: replay each env step as one CUDA graph (mjmaze.backends.warp.MazeBatchEnv's cuda_graph)"""
     torch_threads: int | None = None
     """CPU threads for the network's update (None: PyTorch's default); on CPU the rollout uses one"""
     run_name: str | None = None
@@ -110,8 +112,8 @@ class _RunSettings:
                 raise ValueError(f"--{name.replace('_', '-')} must be positive, got {getattr(self, name)}")
         if not 0 <= self.gamma <= 1:
             raise ValueError(f"--gamma must lie in [0, 1], got {self.gamma}")
-        if self.backend not in ("cpu", "warp"):
-            raise ValueError(f"--backend must be cpu or warp, got {self.backend!r}")
+        if self.backend not in BACKENDS:
+            raise ValueError(f"--backend must be {' or '.join(BACKENDS)}, got {self.backend!r}")
         if self.cuda_graph and self.backend != "warp":
             raise ValueError("--cuda-graph replays the Warp backend's steps: pass it with --backend warp")
         pick_device(self.device)
@@ -122,7 +124,7 @@ class _RunSettings:
             self._validate_vizdoom()
 
     def _validate_vizdoom(self) -> None:
-        from mjmaze import vizdoom_env
+        from mjmaze.backends import vizdoom_env
 
         if self.backend != "cpu":
             raise ValueError("--engine vizdoom runs ViZDoom in worker processes: leave --backend at cpu")
@@ -141,7 +143,7 @@ class _RunSettings:
     def env_id(self) -> str:
         """What the envs play: mjmaze's versioned gym id, or the released setting on ViZDoom."""
         if self.engine == "vizdoom":
-            from mjmaze import vizdoom_env
+            from mjmaze.backends import vizdoom_env
 
             return vizdoom_env.engine_id(self.scenario, self.difficulty_value(), self.freedoom)
         return registry.get(self.scenario).gym_id
@@ -157,7 +159,7 @@ ENGINES = ("mjmaze", "vizdoom")
 
 # One flag per difficulty argument of the registered scenarios (--size,
 # --num-items, --complexity), read from the registry like the other tools'
-# flags (mjmaze.cli.difficulty_arguments): a scenario added in mjmaze/tasks/
+# flags (mjmaze.cli.difficulty_arguments): a scenario added in mjmaze/scenarios/
 # brings its own.
 DIFFICULTY_FLAGS = {
     name: f"the difficulty of {', '.join(scenarios)} (None: the scenario's default)"

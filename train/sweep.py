@@ -33,7 +33,9 @@ import time
 
 from tqdm import tqdm
 
-from mjmaze import files, registry, suite
+from mjmaze import files
+from mjmaze.backends import suite
+from mjmaze.game import registry
 
 from . import a2c, checkpoint, evaluate, published
 from .settings import Args
