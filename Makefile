@@ -22,8 +22,8 @@ TRITON ?= triton==3.7.1
 # CUDA build). Without an NVIDIA GPU: TORCH_INDEX=https://download.pytorch.org/whl/cpu
 TORCH_INDEX ?=
 # The main job (mjmaze.train.first_run): A2C on Labyrinth 5x5 with the paper's
-# configuration, ~13 minutes of training on 2 CPU cores, then a greedy evaluation
-# beside a random policy, a learning curve and a video.
+# configuration, then a greedy evaluation beside a random policy, a learning
+# curve and a video. Its measured time and success: docs/learning.md, "The main job".
 RUN_STEPS ?= 1100000
 RUN_ARGS ?=
 
@@ -41,9 +41,13 @@ FAST := not slow and not warp and not ray and not display
 test-fast: system-deps $(VENV)/.stamp-torch $(VENV)/.stamp-train,dev
 	$(PY) -m pytest -q -m "$(FAST)"
 
+# docs/speed.md's CPU figures, with the flags they were measured with (the bench
+# extra brings ViZDoom and numba, Doom's compiled light); run with nothing else on
+# the cores. Training's figure needs torch: bench/train_speed.py (docs/speed.md).
 bench: system-deps $(VENV)/.stamp-bench
-	$(PY) bench/speed.py
-	$(PY) bench/multiproc.py
+	$(PY) bench/multiproc.py --rounds 3 --seconds 4 --no-scaling --no-draw
+	$(PY) bench/multiproc.py --rounds 3 --seconds 4 --no-scaling --no-draw --scenario two_colour
+	$(PY) bench/speed.py --rounds 4 --steps 3000
 
 setup: system-deps $(VENV)/.stamp-torch $(VENV)/.stamp-all
 

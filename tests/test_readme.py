@@ -75,3 +75,26 @@ def test_every_link_and_picture_exists():
 
 def test_the_readme_stays_a_short_guide():
     assert len(README.splitlines()) <= 320
+
+
+# Each measured figure lives on one page, the one its benchmark or run fills (docs/architecture.md,
+# "Where each figure lives"); the README links there, or quotes a figure that page holds verbatim.
+FIGURE_SOURCES = ("docs/speed.md", "docs/learning.md", "docs/fidelity.md")
+FIGURE = re.compile(r"(?:\d[\d,.]*\s?(?:–|-|to)\s?)?\d[\d,.]*\s?(?:obs/s|µs|us\b|ms\b|min\b|minutes|hours?\b|%)")
+
+
+def figures(text: str) -> list[str]:
+    """Every number ``text`` gives in obs/s, µs, ms, minutes, hours or %, a range as its two ends."""
+    return [number.rstrip(".,") for figure in FIGURE.findall(text) for number in re.findall(r"\d[\d,.]*", figure)]
+
+
+def test_every_figure_of_the_readme_is_on_its_source_page():
+    sources = "\n".join((ROOT / page).read_text() for page in FIGURE_SOURCES)
+    missing = [number for number in figures(README)
+               if not re.search(rf"(?<![\d,.]){re.escape(number)}(?![\d]|[.,]\d)", sources)]
+    assert not missing, f"figures the README states that {', '.join(FIGURE_SOURCES)} do not hold: {missing}"
+
+
+def test_the_figure_check_sees_figures_as_the_readme_wrote_them():
+    text = "A2C ~4,100 obs/s, 1,400–1,700 obs/s; ~6 min once set up; 96 µs; 70-80% sampled, 19.5%."
+    assert figures(text) == ["4,100", "1,400", "1,700", "6", "96", "70", "80", "19.5"]

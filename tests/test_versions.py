@@ -82,6 +82,13 @@ def test_the_package_version_is_the_latest_release():
     assert pyproject == mjmaze.__version__ == versions.package_version() == RELEASED[-1]
 
 
+def test_the_citation_names_the_latest_release():
+    citation = (ROOT / "CITATION.cff").read_text()
+    version = re.search(r'^version: "?([^"\n]+?)"?$', citation, flags=re.MULTILINE).group(1)
+    date = re.search(r'^date-released: "?([^"\n]+?)"?$', citation, flags=re.MULTILINE).group(1)
+    assert (version, date) == [(name, day) for name, day in versions.RELEASES if day][-1]
+
+
 # Where a current id may be written out: the table (mjmaze.game.versions, which writes none),
 # the history (CHANGELOG.md, docs/notes/) and the README (whose snippets tests/test_readme.py runs).
 _MAY_NAME_CURRENT_IDS = ("CHANGELOG.md", "README.md", "docs/notes/")

@@ -287,8 +287,8 @@ def cpu_threads(args: Args, device: torch.device) -> tuple[int, int]:
 
     On CPU the rollout's forward passes (one small batch per step) run on one
     thread: the env processes need the other cores then, and idle OpenMP
-    threads spin on them (measured: a pipe send to a worker took 2.4 ms instead
-    of ~0.1 ms with two torch threads). The update has the cores to itself.
+    threads spin on them (measured: a pipe send to a worker took over ten times
+    as long with two torch threads as with one). The update has the cores to itself.
     """
     update_threads = args.torch_threads or torch.get_num_threads()
     return (1 if device.type == "cpu" else update_threads), update_threads

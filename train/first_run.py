@@ -1,6 +1,6 @@
 """The main job (``make run``): train an agent on Labyrinth 5x5, then show what it learned.
 
-    python -m mjmaze.train.first_run                         # ~13 minutes of training on 2 CPU cores
+    python -m mjmaze.train.first_run                         # 1.1M agent steps
     python -m mjmaze.train.first_run --total-steps 2000000   # longer
 
 Four steps, each a tool a researcher can run alone: ``mjmaze.train.a2c``
@@ -10,17 +10,16 @@ agent with sampled actions where greedy lags); ``mjmaze.train.curves`` draws
 the learning curve (with the random policy's level and the agent's greedy
 evaluation); ``mjmaze.train.record`` films the agent on two test mazes.
 Everything lands in the run's folder; the last three lines printed say what
-was trained, whether it learned (test success >= 60% and >= 3x a random
-policy's), and where the pictures are.
+was trained, whether it learned, and where the pictures are. "Learned": test
+success >= 60% and >= 3x a random policy's (``LEARNED_SUCCESS``,
+``LEARNED_OVER_CHANCE``), greedy or, where greedy lags, with sampled actions
+(the better of the two; the summary prints both).
 
 **Decision** (docs/learning.md, "The main job"): the paper's configuration,
-16 envs x 128 steps per update, lr 7e-4, for 1.1M steps. Chosen by success per
-minute of wall clock on 2 CPU cores, with the frame pipeline's speed: it
-trains at ~1,400-1,700 obs/s; its training episodes succeed 77% / 83% of the
-time at 1.0M / 1.1M steps, its greedy test success was 33% / 51% / 72% at
-0.8M / 1.0M / 1.2M (seed 0; a random policy ~20%), where 256 envs x 16
-steps, lr 1e-3 (the previous choice) was at the random policy's level at 1M.
-1.1M steps keep the whole job within 20 minutes on a fresh 2-core machine.
+16 envs x 128 steps per update, lr 7e-4, for 1.1M steps, chosen by success per
+minute of wall clock on 2 CPU cores against 256 envs x 16 steps, lr 1e-3 (the
+previous choice); the runs that decided it: docs/notes/learning.md. What a run
+takes and reaches, measured: docs/learning.md's table of ``make run`` runs.
 """
 
 from __future__ import annotations

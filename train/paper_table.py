@@ -1,6 +1,6 @@
 """The paper's own agents in mjmaze beside the paper's Table 2, and beside the same agents in ViZDoom.
 
-    python -m mjmaze.train.paper_table                                    # all 16 settings (~25 min on 2 cores)
+    python -m mjmaze.train.paper_table                                    # all 16 settings (time: docs/fidelity.md)
     python -m mjmaze.train.paper_table --only labyrinth_9 two_colour_1
     python -m mjmaze.train.paper_table --vizdoom runs/paper/vizdoom.json  # + tools/paper_agents_vizdoom.py's column
     python -m mjmaze.train.paper_table --plays 8 --seed 1 --redo          # more episodes: tighter intervals

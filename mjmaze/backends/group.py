@@ -108,8 +108,8 @@ class EnvGroup:
         """One agent step of ``rows`` (``actions`` indexed by row): ``(reward, terminated, truncated)`` of every row.
 
         Each env's tics run on their own (a batched ``physics.batch_tics`` over
-        the group measured slower: 706 against 682 us per env step, a group of
-        8), then the rules once for every row: a row not in ``rows`` goes
+        the group was slower on the CPU: numpy's per-call cost on tiny arrays;
+        docs/speed.md), then the rules once for every row: a row not in ``rows`` goes
         through them on its old state, which its caller replaces (it restarts).
         """
         table = self.rules.actions
@@ -197,7 +197,7 @@ class EnvGroup:
     def _leave_out_unseen(self, scene: dict, k: int, row: int) -> np.ndarray | None:
         """Hides the sprites outside the view (entry ``k`` of the scene) for row ``row``'s next render;
         returns the sprites' groups to put back after it (None: none hidden). Llvmpipe pays for every
-        picture sent, seen or not: Two-colour's ~25 items cost ~90 us a frame."""
+        picture sent, seen or not, so a scenario with many items (Two-colour) draws faster without the unseen."""
         if self._sprite_ids is None:
             return None
         unseen = ~scene["sprite_in_view"][k]

@@ -170,8 +170,7 @@ def batch_tics(xp, qpos, qvel, forward, turn, turn_held, timestep: float, path, 
     2)`` receives each tic's ``(x, y)``. The same arithmetic as
     :meth:`MazePhysics.step`, which runs it on floats for one env: numpy's
     per-call cost on small arrays made this function slower on the CPU, for one
-    env (337 against 67 us per agent step) and for a vector env's process's
-    8 envs (706 against 682 us per env step, frames included; docs/speed.md).
+    env and for a vector env's process's group of envs (docs/speed.md).
     tests/test_warp.py holds the two to the same poses. Returns ``(turn_held, bob)``.
     """
     for tic in range(path.shape[1]):

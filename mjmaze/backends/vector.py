@@ -177,11 +177,11 @@ class _SharedGroup:
 def _poll_then_block(conn, poll_seconds: float) -> None:
     """Returns once ``conn`` can be read: polls for up to ``poll_seconds``, then sleeps.
 
-    A process that sleeps between steps wakes up late (~0.2 ms on a virtual
-    machine) and slow (caches gone cold): measured, a worker that blocked on its
-    pipe took ~600 us per env step against ~500 us for one that polled
-    (bench/multiproc.py). Polling only pays while every process has its own
-    core, so the vector env polls only then.
+    A process that sleeps between steps wakes up late (more so on a virtual
+    machine) and slow (caches gone cold): a worker that blocked on its pipe
+    took longer per env step than one that polled (``bench/multiproc.py``
+    compares). Polling only pays while every process has its own core, so the
+    vector env polls only then.
     """
     clock = time.perf_counter
     poll_until = clock() + poll_seconds

@@ -31,8 +31,8 @@ VISUAL_STYLES = ("textured", "flat")
 
 
 #: Side of the floor's quads. Chosen when a lamp lit the floor at their
-#: corners (with 1 m quads the floor under the eye flashed 2.5x brighter each
-#: time the agent passed a corner; 0.5 m cost ~30 us of a frame on llvmpipe).
+#: corners (with 1 m quads the floor under the eye flashed brighter each time
+#: the agent passed a corner; finer quads cost llvmpipe more per frame).
 #: Since Doom's light (mjmaze.drawing.look) GL lights evenly; larger quads (1, 2,
 #: 20 m) stepped no faster within the noise and moved a few pixels in a
 #: million, so they stay (CHANGELOG.md, "Speed measurements").
@@ -63,7 +63,7 @@ class ObjectGeom:
     MuJoCo's midphase keeps the world body's geom bounds from compile time: a
     colliding world geom could not move). Any other object is a world geom,
     placed by writing ``model.geom_pos``: a body each made every ``mj_step``
-    about twice as dear with Two-colour's 90 items (43 against 21 us per 4 tics).
+    dearer, the more so the more items a scenario has (Two-colour).
     ``z`` is the height of the geom's centre. Objects start hidden.
 
     ``sprite`` (textured style only): Doom's picture of the thing

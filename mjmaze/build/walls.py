@@ -5,10 +5,9 @@ collision boxes, one per possible wall segment of the grid, and one visual mesh
 with room for all of them. :class:`WallLayout` turns on the boxes of the walls a
 configuration has (the rest stay in place with collisions off) and rewrites
 the visual mesh in place, so a new maze every episode costs no
-recompile and no new GL context: a recompile costs milliseconds, and a new
-model needs a new GL context too (meshes and textures are uploaded when one is
-made), against ~130 ms for a whole episode (``bench/reset.py`` measures the
-options: ~0.7 ms per reset here, ~6.7 ms recompiling).
+recompile and no new GL context: a recompile costs several times a reset
+done this way, and a new model needs a new GL context too (meshes and textures
+are uploaded when one is made); ``bench/reset.py`` measures the options.
 """
 
 from __future__ import annotations
@@ -184,9 +183,9 @@ def _wall_mesh(h_walls: bytes, h_shape: tuple, v_walls: bytes, v_shape: tuple, c
     """The visual wall mesh of one wall layout (:func:`_box_mesh` of its pieces), cached.
 
     An env cycles through its set of configurations (256 by default), and
-    building the mesh cost as much as the rest of a reset (~0.7 of ~1.2 ms): a
-    trained agent's short episodes made it a quarter of the env's time. The
-    cache is per process, shared by its envs; a 9x9 mesh takes ~50 KB.
+    building the mesh cost about as much as the rest of a reset, a large share
+    of the env's time with a trained agent's short episodes (``bench/reset.py``).
+    The cache is per process, shared by its envs; a 9x9 mesh takes ~50 KB.
     """
     h = np.frombuffer(h_walls, dtype=bool).reshape(h_shape)
     v = np.frombuffer(v_walls, dtype=bool).reshape(v_shape)

@@ -3,12 +3,12 @@
 The numpy path makes ~15 passes over every pixel and gathers each pixel's
 gain from a table; this loop makes one, in the same float32 operations in the
 same order, so its frames are the numpy path's bit for bit
-(``tests/test_look.py`` checks it on scripted episodes). Measured on a group of
-8 Labyrinth 9 frames: ~18 µs a frame against ~52 (docs/speed.md).
+(``tests/test_look.py`` checks it on scripted episodes). How much sooner:
+docs/speed.md, "The vector env".
 
 Compiled with numba (the ``fast`` extra, which ``train`` and ``dev`` include) on
 first use and cached on disk (under ``__pycache__``, or numba's user-wide cache
-where that is not writable): ~1 s once per machine. Without numba, or with
+where that is not writable): once per machine. Without numba, or with
 ``MJMAZE_COMPILED_LIGHT=0``, :class:`mjmaze.drawing.look.DoomLight` stays on numpy.
 numba's LLVM is its own (llvmlite links it statically and exports none of its
 symbols), so it and Mesa's llvmpipe live in one process in either order

@@ -118,9 +118,9 @@ def gl_context():
     if _gl_context is not None and _gl_pid == os.getpid():
         return _gl_context
     # llvmpipe rasterises in the calling thread with LP_NUM_THREADS=0, which is
-    # faster for our tiny frames (measured: ~3,850 against ~2,250 obs/s with one
-    # llvmpipe thread, in one process; no difference with one process per
-    # core); a user's setting wins. Set
+    # faster for our tiny frames (measured against one llvmpipe thread: faster
+    # in one process, no different with one process per core); a user's
+    # setting wins. Set
     # before the probe below, which may load the driver.
     os.environ.setdefault("LP_NUM_THREADS", "0")
     backend = choose_backend()
