@@ -14,14 +14,16 @@ import sys
 import warnings
 
 _LAYERS = {
-    "game": ("core", "rules", "configs", "maze", "doom", "registry", "versions", "layouts"),
+    "game": ("core", "configs", "maze", "doom", "registry", "versions", "layouts"),
     "build": ("arena", "mjcf", "walls", "sprites", "palette"),
     "drawing": ("look", "render", "compiled_light"),
     "backends": ("physics", "group", "batch", "vector", "warp", "suite", "gym_env"),
 }
 #: Old path -> new path.
 MOVED = {f"mjmaze.{name}": f"mjmaze.{layer}.{name}" for layer, names in _LAYERS.items() for name in names}
-MOVED |= {"mjmaze.tasks": "mjmaze.scenarios", "mjmaze.tasks.base": "mjmaze.backends.dm_task"}
+# Renamed too: the array kernels were "rules", the scenario's core's own name; the tasks were no Tasks.
+MOVED |= {"mjmaze.rules": "mjmaze.game.arrays", "mjmaze.tasks": "mjmaze.scenarios",
+          "mjmaze.tasks.base": "mjmaze.backends.dm_task"}
 MOVED |= {f"mjmaze.tasks.{name}": f"mjmaze.scenarios.{name}"
           for name in ("labyrinth", "find_return", "k_item", "two_colour")}
 

@@ -6,7 +6,7 @@ test that runs "every scenario" reads the registry and so runs this one too.
 from __future__ import annotations
 
 from mjmaze.build import mjcf
-from mjmaze.game import configs, core, maze, registry, rules
+from mjmaze.game import configs, core, maze, registry, arrays
 
 GOAL = mjcf.ObjectGeom("goal", "sphere", (0.15,), (1.0, 0.9, 0.0, 1.0), 0.3)
 
@@ -23,7 +23,7 @@ class Beacon(core.MazeRules):
         super().__init__(difficulty=size, layout=layout, **kwargs)
 
     def start(self, xp, config, keys):
-        batch, device = keys.shape[0], rules.device(keys)
+        batch, device = keys.shape[0], arrays.device(keys)
         return {
             "pose": xp.concat([config["spawn_xy"], self.spawn_yaw(xp, keys)[:, None]], axis=1),
             "object_xy": config["object_xy"],
@@ -32,7 +32,7 @@ class Beacon(core.MazeRules):
         }
 
     def rules(self, xp, state, path):
-        state["reached"] = rules.touched(xp, state["object_xy"][:, 0], path)
+        state["reached"] = arrays.touched(xp, state["object_xy"][:, 0], path)
         return xp.astype(state["reached"], xp.float64), state["reached"]
 
     def episode_metrics(self, state):

@@ -33,13 +33,13 @@ def test_the_table_gives_the_observations_each_engine_needs_to_reach_the_papers_
     rows = engines.table(data).splitlines()[2:]
     assert len(rows) == 3
     level_430, level_530, level_700 = rows
-    assert "| 0.38M (1) | 2.88M (1) | 0.13 **over 1.5×** |" in level_430  # 440 from the start; ViZDoom climbs to it
+    assert "| 0.38M (1) | 2.88M (1) | 0.13 **over 1.5×** | – / – |" in level_430  # 440 from the start; ViZDoom climbs
     assert "> 10.00M (1)" in level_530 and "> 2.1" in level_530  # mjmaze never reaches 530: a bound
     # Adding a run again replaces its record (same setting, engine and seed).
     engines.add([write_run(tmp_path / "m0b", "mjmaze", 0, climbing)], data_file)
     data = engines.read_data(data_file)
     assert len(data["runs"]) == 2
-    assert engines.table(data).splitlines()[2].endswith("| 1.00 |")
+    assert engines.table(data).splitlines()[2].endswith("| 1.00 | – / – |")
 
 
 def test_draw_rewrites_only_the_table_between_its_markers(tmp_path):
@@ -59,3 +59,15 @@ def test_the_committed_table_is_the_one_the_data_file_gives():
     page = (pathlib.Path(__file__).parents[1] / engines.LEARNING_PAGE).read_text()
     between = page.split(engines.TABLE_START, 1)[1].split(engines.TABLE_END, 1)[0]
     assert between.strip() == engines.table(data).strip(), "run python -m mjmaze.train.engines draw"
+
+
+def test_the_table_gives_each_engines_greedy_test_value_at_the_papers_step(tmp_path):
+    run = write_run(tmp_path / "v0", "vizdoom", 0, np.full(24, 450.0))
+    (run / "evals").mkdir()
+    for step, test in ((2_500_000, 470.0), (5_000_000, 520.0), (4_000_000, 999.0)):
+        (run / "evals" / f"step_{step}.json").write_text(json.dumps(
+            {"step": step, "train": {"value": 0.0}, "test": {"value": test}}))
+    data_file = tmp_path / "engines.json"
+    engines.add([run], data_file)
+    rows = engines.table(engines.read_data(data_file)).splitlines()[2:]
+    assert rows[0].endswith("| – / 470 |") and rows[1].endswith("| – / 520 |") and rows[2].endswith("| – / – |")

@@ -88,3 +88,31 @@ def test_the_check_sees_an_upward_import_but_not_a_type_hint(tmp_path):
         "if TYPE_CHECKING:\n    from mjmaze.build import mjcf\n")
     found = imported(fake / "game" / "bad.py", fake)
     assert found == [(2, "mjmaze.backends"), (3, "mjmaze.game")]
+
+
+def test_the_old_module_paths_import_for_one_more_release_with_a_warning():
+    # In a fresh interpreter: this one may have imported the old paths already.
+    import subprocess
+    import sys
+
+    script = (
+        "import warnings\n"
+        "warnings.simplefilter('error', DeprecationWarning)\n"
+        "import mjmaze\n"
+        "for old, new in (('mjmaze.vector', 'mjmaze.backends.vector'), ('mjmaze.tasks.two_colour',\n"
+        "                 'mjmaze.scenarios'), ('mjmaze.rules', 'mjmaze.game.arrays')):\n"
+        "    try:\n"
+        "        __import__(old)\n"
+        "    except DeprecationWarning as warning:\n"
+        "        assert new in str(warning), warning\n"
+        "    else:\n"
+        "        raise SystemExit(old + ' gave no warning')\n"
+        "warnings.simplefilter('ignore', DeprecationWarning)\n"
+        "from mjmaze.vector import MazeVectorEnv\n"
+        "from mjmaze import suite\n"
+        "assert MazeVectorEnv.__module__ == 'mjmaze.backends.vector' and suite.load is mjmaze.load\n"
+        "import mjmaze.backends.vector as moved\n"
+        "assert moved.__spec__.name == 'mjmaze.backends.vector'\n"
+    )
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr[-2000:]

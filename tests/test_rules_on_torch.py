@@ -15,7 +15,7 @@ from conftest import SMALL_SETTINGS
 
 from mjmaze.backends import suite
 from mjmaze.drawing import look
-from mjmaze.game import rules
+from mjmaze.game import arrays
 
 torch = pytest.importorskip("torch")
 
@@ -47,7 +47,7 @@ def test_rules_compile_whole_and_match_numpy(scenario):
     configs = [task.rules.configs[i % len(task.rules.configs)] for i in range(NUM_ENVS)]
     table = task.rules.config_arrays(configs)
     keys = np.arange(NUM_ENVS, dtype=np.int64) * 7919 + 1
-    tnp = rules.namespace(torch.zeros(1))
+    tnp = arrays.namespace(torch.zeros(1))
     start = torch.compile(lambda config, k: task.rules.start_state(tnp, config, k), fullgraph=True, backend="eager")
     step = torch.compile(lambda state, path: task.rules.step_state(tnp, state, path), fullgraph=True, backend="eager")
 
@@ -76,7 +76,7 @@ def _assert_same(on_numpy: dict, on_torch: dict, when: str) -> None:
 def test_flash_compiles_whole_and_matches_numpy():
     damage = np.array([0, 3, 40, 120, 0], dtype=np.int64)
     bonus = np.array([0, 0, 6, 2, 9], dtype=np.int64)
-    tnp = rules.namespace(torch.zeros(1))
+    tnp = arrays.namespace(torch.zeros(1))
     flash = torch.compile(lambda d, b: look.flash_tint(tnp, d, b), fullgraph=True, backend="eager")
     for a, b in zip(look.flash_tint(np, damage, bonus), flash(torch.as_tensor(damage), torch.as_tensor(bonus))):
         np.testing.assert_array_equal(a, b.numpy())

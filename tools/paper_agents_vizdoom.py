@@ -58,7 +58,7 @@ from mjmaze.backends.vizdoom_env import frame as _frame
 from mjmaze.backends.vizdoom_env import maze_seed as _maze_seed
 from mjmaze.backends.vizdoom_env import released_game as _game
 from mjmaze.build import sprites
-from mjmaze.game import rules
+from mjmaze.game import arrays
 from mjmaze.game.doom import FIRST_OBSERVATION_TIC, MAP_UNIT, TICS_PER_STEP
 from mjmaze.scenarios import two_colour
 
@@ -197,9 +197,9 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
                     break
                 now = game.get_game_variable(vzd.GameVariable.HEALTH)
                 if now < health:
-                    flashes[0] = min(flashes[0] + int(health - now), rules.MAX_DAMAGE_COUNT)
+                    flashes[0] = min(flashes[0] + int(health - now), arrays.MAX_DAMAGE_COUNT)
                 if now > health or now <= health - 12:  # an item: +25, or a wrong one's 13 or 17
-                    flashes[1] += rules.BONUS_TICS
+                    flashes[1] += arrays.BONUS_TICS
                 health = now
         game.close()
         _reset_to(env, index)

@@ -138,10 +138,23 @@ def _millions(steps: int | None, last: int) -> str:
     return f"{steps / 1e6:.2f}M" if steps is not None else f"> {last / 1e6:.2f}M"
 
 
+def greedy_test_at(records: list[dict], step: int) -> str:
+    """The seeds' mean greedy test value at the evaluation nearest ``step`` (within :data:`BIN_STEPS`), or "–"."""
+    values = []
+    for r in records:
+        near = [(abs(int(s) - step), v[1]) for s, v in r["evaluations"].items() if abs(int(s) - step) <= BIN_STEPS]
+        if near:
+            values.append(min(near)[1])
+    return f"{np.mean(values):.4g}" if values else "–"
+
+
 def table(data: dict) -> str:
-    """The markdown table: per setting and paper level, the observations each engine's seeds needed, and their ratio."""
-    lines = ["| setting | paper's level (its step) | mjmaze: obs to reach it (seeds) | ViZDoom: obs (seeds) | mjmaze ÷ ViZDoom |",
-             "|---|---|---|---|---|"]
+    """The markdown table: per setting and paper level, the observations each engine's seeds needed to reach
+    it in training episodes, their ratio, and each engine's greedy test value at the paper's step (the
+    paper's curves are its periodic greedy evaluations on test mazes, docs/learning.md)."""
+    lines = ["| setting | paper's level (its step) | mjmaze: obs to reach it (seeds) | ViZDoom: obs (seeds) "
+             "| mjmaze ÷ ViZDoom | greedy test there: mjmaze / ViZDoom |",
+             "|---|---|---|---|---|---|"]
     for setting in sorted({r["setting"] for r in data["runs"]}):
         scenario = setting.rpartition("_")[0]
         units, digits = published.curve_units(scenario), published.of(scenario).metric_digits
@@ -157,7 +170,9 @@ def table(data: dict) -> str:
                 reached[engine] = (at, last)
                 cells.append(f"{_millions(at, last)} ({len(records)})")
             ratio = _ratio(reached)
-            lines.append(f"| {setting} | {level:.{digits}f} {units} ({step / 1e6:g}M) | {cells[0]} | {cells[1]} | {ratio} |")
+            greedy = " / ".join(greedy_test_at(records, step) if records else "–" for records in by_engine.values())
+            lines.append(f"| {setting} | {level:.{digits}f} {units} ({step / 1e6:g}M) | {cells[0]} | {cells[1]} "
+                         f"| {ratio} | {greedy} |")
     return "\n".join(lines)
 
 

@@ -39,7 +39,8 @@ class _RunSettings:
     alpha: float = 0.99
     """RMSprop smoothing constant"""
     eps: float = 1e-5
-    """RMSprop epsilon (the released train_a2c.py passes its --eps 1e-5 to RMSprop)"""
+    """RMSprop epsilon. The released a2c_agent.py parses --eps 1e-5 but passes none to RMSprop, whose default
+    was 1e-8: kept until a run measures the difference (docs/notes/learning.md, 2026-11-29)"""
     value_coef: float = 0.5
     """weight of the value loss"""
     entropy_coef: float = 0.001

@@ -20,7 +20,7 @@ from gymnasium.vector import AutoresetMode
 from gymnasium.vector.utils import batch_space
 
 from mjmaze.drawing import look
-from mjmaze.game import core, rules
+from mjmaze.game import core, arrays
 
 AUTORESET_MODES = {"next_step": AutoresetMode.NEXT_STEP, "same_step": AutoresetMode.SAME_STEP}
 
@@ -47,7 +47,7 @@ def env_seeds(seed: int | Sequence[int] | None, num_envs: int) -> list[int] | No
 
 def seed_keys(seeds: Sequence[int]) -> np.ndarray:
     """``(N,)`` int64: the rules' key of an env seeded with each seed, as a single env's ``reset(seed=s)`` draws it."""
-    return np.array([rules.seed_key(np.random.RandomState(s)) for s in seeds], dtype=np.int64)
+    return np.array([arrays.seed_key(np.random.RandomState(s)) for s in seeds], dtype=np.int64)
 
 
 def check_actions(actions, num_envs: int, num_actions: int) -> np.ndarray:

@@ -26,7 +26,7 @@ from mjmaze.build.arena import Arena
 from mjmaze.drawing import look
 from mjmaze.game import configs, core, doom
 from mjmaze.game.core import EPISODE_STEPS
-from mjmaze.game.rules import seed_key
+from mjmaze.game.arrays import seed_key
 
 
 class MazeTask(base.Task):

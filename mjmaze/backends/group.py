@@ -31,7 +31,7 @@ class EnvGroup:
       view: how the frames look (:class:`mjmaze.drawing.look.View`).
       physics: each env's physics, built from the scenario's arena with its projection
         (:func:`mjmaze.backends.dm_task.make_physics`).
-      seed_keys: each env's key for its episodes' draws (:func:`mjmaze.game.rules.seed_key`).
+      seed_keys: each env's key for its episodes' draws (:func:`mjmaze.game.arrays.seed_key`).
       first_configs: where each env starts cycling through the configurations (default: the rules').
     """
 

@@ -18,7 +18,7 @@ import numpy as np
 from dm_control import mujoco
 
 from mjmaze.build import mjcf
-from mjmaze.game import core, doom, rules
+from mjmaze.game import core, doom, arrays
 
 if TYPE_CHECKING:
     from mjmaze.build.arena import ArenaIds
@@ -221,4 +221,4 @@ MAX_BOB = 16.0  # map units (Doom's MAXBOB)
 def walking_bob(xp, vx, vy, timestep: float):
     """Doom's bob in map units of a tic whose velocity after its thrust is ``(vx, vy)`` (m/s)."""
     speed_sq = (vx * vx + vy * vy) * (timestep / doom.MAP_UNIT) ** 2  # (map units per tic)^2
-    return rules.at_most(xp, speed_sq / 4, MAX_BOB)
+    return arrays.at_most(xp, speed_sq / 4, MAX_BOB)

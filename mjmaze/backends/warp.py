@@ -49,7 +49,7 @@ from mjmaze.backends import batch, physics, suite
 from mjmaze.build import mjcf, walls
 from mjmaze.build.arena import Arena, ArenaIds
 from mjmaze.drawing import look
-from mjmaze.game import core, doom, rules
+from mjmaze.game import core, doom, arrays
 
 # Where a geom that must not be seen or touched in a world goes (below the floor).
 _AWAY_Z = -50.0
@@ -165,7 +165,7 @@ class MazeBatchEnv(batch.BatchEnv):
             raise ValueError("cuda_graph=True cannot replay restart_by_index=True (it reads the restarting worlds' "
                              "count back from the device); leave restart_by_index at its default")
         self._wp_device = wp.get_device(str(device))
-        self.xp = rules.namespace(torch.zeros(1))
+        self.xp = arrays.namespace(torch.zeros(1))
         height, width = view.height, view.width
 
         mjm, ids, mesh_of_config, box_z = build_model(task, view)

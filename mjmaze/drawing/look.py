@@ -3,7 +3,7 @@
 The CPU renderer (:class:`mjmaze.drawing.render.EgoRenderer`, one frame) and the
 MuJoCo Warp backend (:mod:`mjmaze.backends.warp`, every world's frame at once) draw the
 scene their own way; what comes after is the same array code for both, on
-numpy or torch (``xp``, as :mod:`mjmaze.game.rules`), in this module. All of it was
+numpy or torch (``xp``, as :mod:`mjmaze.game.arrays`), in this module. All of it was
 measured in ViZDoom (docs/look.md).
 """
 
@@ -18,7 +18,7 @@ import numpy as np
 
 from mjmaze.build import mjcf, palette, sprites, walls
 from mjmaze.drawing import compiled_light
-from mjmaze.game import doom, rules
+from mjmaze.game import doom, arrays
 
 DEFAULT_WIDTH, DEFAULT_HEIGHT = 112, 64
 
@@ -134,14 +134,14 @@ def draw_pistol(xp, frames, dx, dy) -> None:
     for the mask's count).
     """
     _, height, width, _ = frames.shape
-    dev = rules.device(frames)
+    dev = arrays.device(frames)
     rows = xp.arange(height, device=dev)[None, :]
     cols = xp.arange(width, device=dev)[None, :]
     for (rows_box, cols_box, _), (_, colour) in zip(pistol_boxes(width, height), PISTOL):
         in_rows = (rows >= rows_box.start + dy[:, None]) & (rows < rows_box.stop + dy[:, None])  # (B, H)
         in_cols = (cols >= cols_box.start + dx[:, None]) & (cols < cols_box.stop + dx[:, None])  # (B, W)
         inside = in_rows[:, :, None, None] & in_cols[:, None, :, None]
-        frames[...] = xp.where(inside, rules.constant(xp, colour, xp.uint8, dev), frames)
+        frames[...] = xp.where(inside, arrays.constant(xp, colour, xp.uint8, dev), frames)
 
 
 # The view's half-width over depth (Doom's projection, mjcf.set_ego_projection), and the
@@ -163,7 +163,7 @@ class SpriteView:
 
     Made once per model (its sprite geoms: an :class:`mjmaze.build.arena.ArenaIds`'s
     ``sprites`` and ``sprite_objects``) and frame width, on numpy or torch
-    (``xp``, as :mod:`mjmaze.game.rules`); call it before each render with a batch of worlds.
+    (``xp``, as :mod:`mjmaze.game.arrays`); call it before each render with a batch of worlds.
     """
 
     def __init__(self, xp, device, model: mujoco.MjModel, objects: Sequence[mjcf.ObjectGeom], ids, width: int):
@@ -294,7 +294,7 @@ class DoomLight:
         self._top_bin = xp.asarray(_LIGHT_BINS - 1, dtype=xp.float32, device=device)
         self._half = xp.asarray(0.5, dtype=xp.float32, device=device)
         # On the CPU, one compiled pass gives the same frames ~3x sooner (mjmaze.drawing.compiled_light), where numba is.
-        self._compiled = self._compiled_constants(up < 0) if rules.on_host(xp) and compiled_light.available() else None
+        self._compiled = self._compiled_constants(up < 0) if arrays.on_host(xp) and compiled_light.available() else None
 
     def _compiled_constants(self, below: np.ndarray) -> tuple:
         """What :func:`mjmaze.drawing.compiled_light.light` takes beside the frames: this light's tables and
@@ -349,7 +349,7 @@ class DoomLight:
         # The pixels before the wall (things) take the surface of where they lie, as each pixel did
         # before (a thing across a grid line is lit as a wall there): found per pixel, few on a CPU.
         before = ~(flat | on_wall)
-        if rules.on_host(xp):
+        if arrays.on_host(xp):
             pixels = np.flatnonzero(before)
             if len(pixels):
                 world, row, column = np.unravel_index(pixels, before.shape)
@@ -367,7 +367,7 @@ class DoomLight:
         return xp.astype(lit + self._half, xp.uint8)
 
 
-# Doom's full-screen flashes: the tint of the rules' counters (mjmaze.game.rules: damage_count,
+# Doom's full-screen flashes: the tint of the rules' counters (mjmaze.game.arrays: damage_count,
 # bonus_count), as ZDoom blends them (v_blend.cpp; measured in ViZDoom, docs/look.md).
 DAMAGE_RGB = (255, 0, 0)
 BONUS_RGB = (215, 186, 69)
@@ -387,14 +387,14 @@ def flash_tint(xp, damage_count, bonus_count) -> tuple:
     ZDoom adds the gold, then the red, as layers (``AddBlend``) and caps the
     sum's opacity at :data:`MAX_FLASH_ALPHA`.
     """
-    dev = rules.device(damage_count)
-    table = rules.constant(xp, DAMAGE_TO_ALPHA, xp.float64, dev)
+    dev = arrays.device(damage_count)
+    table = arrays.constant(xp, DAMAGE_TO_ALPHA, xp.float64, dev)
     red = table[xp.clip(damage_count, max=len(DAMAGE_TO_ALPHA) - 1)] / 255
     gold = xp.astype(xp.clip(bonus_count * 8, max=128), xp.float64) / 255
     alpha = gold + (1 - gold) * red
     gold_share = xp.where(alpha > 0, gold / xp.where(alpha > 0, alpha, 1.0), 0.0)
-    rgb = (gold_share[:, None] * rules.constant(xp, BONUS_RGB, xp.float64, dev)
-           + (1 - gold_share[:, None]) * rules.constant(xp, DAMAGE_RGB, xp.float64, dev))
+    rgb = (gold_share[:, None] * arrays.constant(xp, BONUS_RGB, xp.float64, dev)
+           + (1 - gold_share[:, None]) * arrays.constant(xp, DAMAGE_RGB, xp.float64, dev))
     return rgb, xp.clip(alpha, max=MAX_FLASH_ALPHA)
 
 
@@ -471,7 +471,7 @@ class FramePipeline:
             frames = self.light(frames, inverse_depth, eye, yaw)
         if self._pistol:
             draw_pistol(xp, frames, *scene["pistol"])
-        if self._flashes and rules.on_host(xp):  # most frames have no flash: no work for them
+        if self._flashes and arrays.on_host(xp):  # most frames have no flash: no work for them
             damage, bonus = state["damage_count"], state["bonus_count"]
             for row in np.flatnonzero((damage > 0) | (bonus > 0)):
                 counts = int(damage[row]), int(bonus[row])

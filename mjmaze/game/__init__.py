@@ -2,7 +2,7 @@
 
 Holds the rules' core (:mod:`~mjmaze.game.core`: ``MazeRules`` and its batched
 state), the array kernels the rules share on numpy and torch
-(:mod:`~mjmaze.game.rules`), the mazes (:mod:`~mjmaze.game.maze`,
+(:mod:`~mjmaze.game.arrays`), the mazes (:mod:`~mjmaze.game.maze`,
 :mod:`~mjmaze.game.configs`, the released layouts in
 :mod:`~mjmaze.game.layouts`), Doom's constants (:mod:`~mjmaze.game.doom`), the
 registry of scenarios and their versioned ids.

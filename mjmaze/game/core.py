@@ -4,7 +4,7 @@ A scenario subclasses :class:`MazeRules` and states only its rules: which
 objects the arena has (:attr:`MazeRules.objects`), how an episode starts
 (:meth:`MazeRules.start`) and what one agent step pays and whether it ends the
 episode (:meth:`MazeRules.rules`). Both are array functions over a batch of
-envs (:mod:`mjmaze.game.rules`): a CPU env calls them with a batch of one on numpy
+envs (:mod:`mjmaze.game.arrays`): a CPU env calls them with a batch of one on numpy
 (its vector env, once per step for each process's envs), the MuJoCo Warp
 backend (:mod:`mjmaze.backends.warp`) with thousands on torch. Nothing here simulates
 or draws, nor knows how frames look (their size and style are a
@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
 
-from mjmaze.game import configs, doom, rules
+from mjmaze.game import configs, doom, arrays
 from mjmaze.game import layouts as layout_files
 
 if TYPE_CHECKING:
@@ -58,7 +58,7 @@ class EpisodeState(TypedDict, total=False):
     object_xy: Any  #: ``(B, objects, 2)`` float64: where each object is
     object_shown: Any  #: ``(B, objects)`` bool: which objects are in the arena
     object_rgba: Any  #: ``(B, k, 4)`` float64, optional: the episode's colours of the first k objects
-    key: Any  #: ``(B,)`` int64: the episode's key for :func:`mjmaze.game.rules.uniform`
+    key: Any  #: ``(B,)`` int64: the episode's key for :func:`mjmaze.game.arrays.uniform`
     steps: Any  #: ``(B,)`` int64: agent steps taken
     episode_return: Any  #: ``(B,)`` float64: the return so far
     animation_start: Any  #: ``(B, objects)`` int64: where each object's animation began (:meth:`MazeRules.animation_start`)
@@ -113,7 +113,7 @@ class MazeRules(abc.ABC):
 
     def episode_keys(self, xp, seed_keys, episodes):
         """Each env's key for the draws of its episode number ``episodes`` (both ``(B,)`` int64)."""
-        return rules.mix(xp, seed_keys, episodes)
+        return arrays.mix(xp, seed_keys, episodes)
 
     def config_indices(self, xp, keys, episodes, first=None):
         """The configuration each env plays in its episode number ``episodes``: ``(B,)`` int64.
@@ -121,10 +121,10 @@ class MazeRules(abc.ABC):
         ``first``: where each env starts cycling (default: ``first_config``).
         """
         if self.config_sampling == "random":
-            return xp.astype(rules.uniform(xp, keys, rules.DRAW_CONFIG) * len(self.configs), xp.int64)
+            return xp.astype(arrays.uniform(xp, keys, arrays.DRAW_CONFIG) * len(self.configs), xp.int64)
         return ((self.first_config if first is None else first) + episodes) % len(self.configs)
 
-    # -- the scenario's rules, over a batch of envs (see mjmaze.game.rules) ---------
+    # -- the scenario's rules, over a batch of envs (see mjmaze.game.arrays) ---------
 
     def config_arrays(self, configs_: Sequence[configs.MazeConfig]) -> dict[str, np.ndarray]:
         """What the rules need of each configuration, stacked: ``(C, ...)`` numpy arrays.
@@ -142,7 +142,7 @@ class MazeRules(abc.ABC):
 
     def spawn_yaw(self, xp, keys):
         """A heading drawn uniformly in ``[-pi, pi)`` per env."""
-        return rules.uniform(xp, keys, rules.DRAW_YAW) * (2 * math.pi) - math.pi
+        return arrays.uniform(xp, keys, arrays.DRAW_YAW) * (2 * math.pi) - math.pi
 
     @abc.abstractmethod
     def start(self, xp, config: dict, keys) -> dict:
@@ -152,7 +152,7 @@ class MazeRules(abc.ABC):
         (the spawn: x, y, yaw), ``object_xy`` ``(B, len(objects), 2)`` and
         ``object_shown`` ``(B, len(objects))``; optionally ``object_rgba``
         ``(B, k, 4)`` (this episode's colours of the first ``k`` objects); plus the scenario's own
-        fields. Random draws come from :func:`mjmaze.game.rules.uniform` with ``keys``.
+        fields. Random draws come from :func:`mjmaze.game.arrays.uniform` with ``keys``.
         """
 
     @abc.abstractmethod
@@ -161,7 +161,7 @@ class MazeRules(abc.ABC):
 
         ``path`` ``(B, tics, 2)`` holds the agent's ``(x, y)`` after each tic of
         the step, so a pick-up passed in the middle of a step counts (Doom tests
-        every tic); see :func:`mjmaze.game.rules.first_tic`. ``state["steps"]`` is the
+        every tic); see :func:`mjmaze.game.arrays.first_tic`. ``state["steps"]`` is the
         number of agent steps taken, this one included.
         """
 
@@ -180,10 +180,10 @@ class MazeRules(abc.ABC):
         the released Labyrinth and K-item mazes (docs/look.md, "Items"). A
         scenario whose script spawns its things overrides this (Two-colour).
         """
-        device = rules.device(keys)
-        first_tics = rules.constant(xp, _first_frame_tics(tuple(self.objects)), xp.int64, device)
+        device = arrays.device(keys)
+        first_tics = arrays.constant(xp, _first_frame_tics(tuple(self.objects)), xp.int64, device)
         index = xp.arange(len(self.objects), dtype=xp.int64, device=device)
-        left = 1 + xp.astype(rules.uniform(xp, keys[:, None], rules.DRAW_ANIMATION, index[None, :]) * first_tics, xp.int64)
+        left = 1 + xp.astype(arrays.uniform(xp, keys[:, None], arrays.DRAW_ANIMATION, index[None, :]) * first_tics, xp.int64)
         return left - first_tics  # the first frame then ends at tic ``left``
 
     def start_state(self, xp, config: dict, keys) -> dict:
@@ -192,11 +192,11 @@ class MazeRules(abc.ABC):
         state = self.start(xp, config, keys)
         state["key"] = keys
         state["animation_start"] = self.animation_start(xp, keys)
-        state["steps"] = xp.zeros(keys.shape, dtype=xp.int64, device=rules.device(keys))
-        state["episode_return"] = xp.zeros(keys.shape, dtype=xp.float64, device=rules.device(keys))
-        # Doom's flash counters (mjmaze.game.rules; their tint: mjmaze.drawing.look.flash_tint); a scenario's rules set them.
+        state["steps"] = xp.zeros(keys.shape, dtype=xp.int64, device=arrays.device(keys))
+        state["episode_return"] = xp.zeros(keys.shape, dtype=xp.float64, device=arrays.device(keys))
+        # Doom's flash counters (mjmaze.game.arrays; their tint: mjmaze.drawing.look.flash_tint); a scenario's rules set them.
         for name in ("damage_count", "bonus_count"):
-            state.setdefault(name, xp.zeros(keys.shape, dtype=xp.int64, device=rules.device(keys)))
+            state.setdefault(name, xp.zeros(keys.shape, dtype=xp.int64, device=arrays.device(keys)))
         return state
 
     def step_state(self, xp, state: dict, path) -> tuple:
@@ -207,10 +207,6 @@ class MazeRules(abc.ABC):
         return reward, terminated, ~terminated & (state["steps"] >= EPISODE_STEPS)
 
     # -- what an env reports ----------------------------------------------------
-
-    @property
-    def action_names(self) -> tuple[str, ...]:
-        return ACTION_NAMES[: len(self.actions)]
 
     def new_episode_metrics(self) -> dict:
         """The metric fields of an episode that has not started (Python scalars)."""
@@ -226,7 +222,7 @@ class MazeRules(abc.ABC):
 @functools.lru_cache(maxsize=None)
 def _first_frame_tics(objects: tuple) -> tuple[int, ...]:
     """Tics of each object's first animation frame (1 without a sprite): one lasting tuple per
-    scenario, as :func:`mjmaze.game.rules.constant` wants."""
+    scenario, as :func:`mjmaze.game.arrays.constant` wants."""
     return tuple(obj.sprite.frames[0][1] if obj.sprite is not None else 1 for obj in objects)
 
 

@@ -24,7 +24,7 @@ Version History
 from __future__ import annotations
 
 from mjmaze.build import mjcf, palette
-from mjmaze.game import configs, core, doom, maze, registry, rules, versions
+from mjmaze.game import configs, core, doom, maze, registry, arrays, versions
 
 if __doc__:  # python -OO drops docstrings
     __doc__ += versions.version_history(versions.FIND_RETURN)
@@ -66,7 +66,7 @@ class FindReturn(core.MazeRules):
         super().__init__(difficulty=size, layout=layout, **kwargs)
 
     def start(self, xp, config, keys):
-        batch, device = keys.shape[0], rules.device(keys)
+        batch, device = keys.shape[0], arrays.device(keys)
         green, red = config["spawn_xy"], config["object_xy"][:, 0]
         return {
             "pose": xp.concat([green - SPAWN_OFFSET, self.spawn_yaw(xp, keys)[:, None]], axis=1),
@@ -80,11 +80,11 @@ class FindReturn(core.MazeRules):
         # The pillars stand in different cells, more than a step apart: one
         # step never touches both, so target and return are checked in turn.
         found = state["target_found"]
-        tic = rules.first_tic(xp, state["object_xy"], path)  # (B, 2): the green pillar's, the red's
+        tic = arrays.first_tic(xp, state["object_xy"], path)  # (B, 2): the green pillar's, the red's
         # The target is an invisible armour (as released): taking it flashes the view gold.
         target_tic = xp.where(found, -1, tic[:, 1])
         target = target_tic >= 0
-        state["bonus_count"] = rules.bonus_after_step(xp, state["bonus_count"], target_tic, path.shape[1])
+        state["bonus_count"] = arrays.bonus_after_step(xp, state["bonus_count"], target_tic, path.shape[1])
         returned = found & (tic[:, 0] >= 0)
         state["target_found"] = found | target
         state["success"] = state["success"] | returned

@@ -28,7 +28,7 @@ Version History
 from __future__ import annotations
 
 from mjmaze.build import mjcf, sprites
-from mjmaze.game import configs, core, doom, maze, registry, rules, versions
+from mjmaze.game import configs, core, doom, maze, registry, arrays, versions
 
 if __doc__:  # python -OO drops docstrings
     __doc__ += versions.version_history(versions.K_ITEM)
@@ -83,7 +83,7 @@ class KItem(core.MazeRules):
         super().__init__(difficulty=num_items, layout=layout, **kwargs)
 
     def start(self, xp, config, keys):
-        batch, device = keys.shape[0], rules.device(keys)
+        batch, device = keys.shape[0], arrays.device(keys)
         return {
             "pose": xp.concat([config["spawn_xy"], self.spawn_yaw(xp, keys)[:, None]], axis=1),
             "object_xy": config["object_xy"],  # object_cells[k] holds item kind k
@@ -94,12 +94,12 @@ class KItem(core.MazeRules):
     def rules(self, xp, state, path):
         # Items are in cells 1.25 m apart: one step (at most 0.27 m) reaches at most
         # one of them, at any of its tics.
-        tic = xp.where(state["object_shown"], rules.first_tic(xp, state["object_xy"], path), -1)
+        tic = xp.where(state["object_shown"], arrays.first_tic(xp, state["object_xy"], path), -1)
         reached = tic >= 0
-        is_next = rules.one_hot(xp, state["next"], self.num_items)
+        is_next = arrays.one_hot(xp, state["next"], self.num_items)
         correct = xp.any(reached & is_next, axis=1)
         # Every item is a Doom pickup (as released): taking one flashes the view gold.
-        state["bonus_count"] = rules.bonus_after_step(xp, state["bonus_count"], xp.max(tic, axis=1), path.shape[1])
+        state["bonus_count"] = arrays.bonus_after_step(xp, state["bonus_count"], xp.max(tic, axis=1), path.shape[1])
         wrong = ~correct & xp.any(reached, axis=1)
         state["object_shown"] = state["object_shown"] & ~(is_next & correct[:, None])
         state["next"] = state["next"] + xp.astype(correct, xp.int64)

@@ -23,7 +23,7 @@ Version History
 from __future__ import annotations
 
 from mjmaze.build import mjcf, sprites
-from mjmaze.game import configs, core, doom, maze, registry, rules, versions
+from mjmaze.game import configs, core, doom, maze, registry, arrays, versions
 
 if __doc__:  # python -OO drops docstrings
     __doc__ += versions.version_history(versions.LABYRINTH)
@@ -57,12 +57,12 @@ class Labyrinth(core.MazeRules):
         return {
             "pose": xp.concat([config["spawn_xy"], self.spawn_yaw(xp, keys)[:, None]], axis=1),
             "object_xy": config["object_xy"],  # the exit
-            "object_shown": xp.ones((batch, 1), dtype=xp.bool, device=rules.device(keys)),
-            "success": xp.zeros(batch, dtype=xp.bool, device=rules.device(keys)),
+            "object_shown": xp.ones((batch, 1), dtype=xp.bool, device=arrays.device(keys)),
+            "success": xp.zeros(batch, dtype=xp.bool, device=arrays.device(keys)),
         }
 
     def rules(self, xp, state, path):
-        reached = rules.touched(xp, state["object_xy"][:, 0], path)
+        reached = arrays.touched(xp, state["object_xy"][:, 0], path)
         state["success"] = state["success"] | reached
         return STEP_REWARD + EXIT_REWARD * xp.astype(reached, xp.float64), reached
 

@@ -45,7 +45,7 @@ from __future__ import annotations
 import numpy as np
 
 from mjmaze.build import mjcf, palette, sprites, walls
-from mjmaze.game import configs, core, doom, registry, rules, versions
+from mjmaze.game import configs, core, doom, registry, arrays, versions
 
 if __doc__:  # python -OO drops docstrings
     __doc__ += versions.version_history(versions.TWO_COLOUR)
@@ -159,16 +159,16 @@ class TwoColour(core.MazeRules):
         return arrays
 
     def start(self, xp, config, keys):
-        batch, device = keys.shape[0], rules.device(keys)
+        batch, device = keys.shape[0], arrays.device(keys)
         totem_xy = config["object_xy"][:, 0]
         spawn_xy = config["spawn_xy"]
-        totem_green = rules.uniform(xp, keys, rules.DRAW_COLOUR) < 0.5
-        rgba = rules.constant(xp, TOTEM_COLOURS, xp.float64, device)  # the totem's colour is drawn per episode
+        totem_green = arrays.uniform(xp, keys, arrays.DRAW_COLOUR) < 0.5
+        rgba = arrays.constant(xp, TOTEM_COLOURS, xp.float64, device)  # the totem's colour is drawn per episode
         # An imported layout may spawn the agent on the totem's spot: the
         # released script's SetActorPosition then fails and both columns stay
         # parked outside the map, so the episode has no totem (measured in ViZDoom).
         no_totem = xp.max(xp.abs(spawn_xy - totem_xy), axis=1) < TOTEM_CLEARANCE
-        totem_xy = xp.where(no_totem[:, None], rules.constant(xp, TOTEM_PARKED_XY, xp.float64, device), totem_xy)
+        totem_xy = xp.where(no_totem[:, None], arrays.constant(xp, TOTEM_PARKED_XY, xp.float64, device), totem_xy)
         state = {
             "pose": xp.concat([spawn_xy, xp.zeros((batch, 1), dtype=xp.float64, device=device)], axis=1),
             "object_xy": xp.concat([totem_xy[:, None], xp.zeros((batch, POOL_SIZE, 2), dtype=xp.float64, device=device)], axis=1),
@@ -192,14 +192,14 @@ class TwoColour(core.MazeRules):
         # The released script spawns the first 21 items at the episode's tic 0 and item 21 + j at
         # tic 30 (j + 1); a thing spawned in play starts its first frame whole, so each item blinks
         # from its spawn (measured in ViZDoom: docs/look.md, "Items"). The totem has no animation.
-        device = rules.device(keys)
+        device = arrays.device(keys)
         return (xp.zeros((keys.shape[0], 1), dtype=xp.int64, device=device)
-                + rules.constant(xp, _ANIMATION_START, xp.int64, device)[None, :])
+                + arrays.constant(xp, _ANIMATION_START, xp.int64, device)[None, :])
 
     def rules(self, xp, state, path):
         shown, health, totem_green = state["object_shown"], state["health"], state["totem_green"]
-        device, tics = rules.device(health), path.shape[1]
-        first_tic = xp.where(shown[:, 1:], rules.first_tic(xp, state["object_xy"][:, 1:], path), -1)
+        device, tics = arrays.device(health), path.shape[1]
+        first_tic = xp.where(shown[:, 1:], arrays.first_tic(xp, state["object_xy"][:, 1:], path), -1)
         picked = first_tic >= 0
         # The step's events, in the order Doom takes them: by tic, and within a
         # tic the floor's hit before the items (by index). Health is capped,
@@ -216,37 +216,37 @@ class TwoColour(core.MazeRules):
         damage, settled = state["damage_count"], xp.full(health.shape, -1, dtype=xp.int64, device=device)
         # A wrong item is the colour the totem is not.
         wrong_damage = xp.where(totem_green, WRONG_RED_DAMAGE, WRONG_GREEN_DAMAGE)
-        for rank in range(rules.loop_count(xp, num_events, 1 + POOL_SIZE)):
+        for rank in range(arrays.loop_count(xp, num_events, 1 + POOL_SIZE)):
             event = order[:, rank]
             tic = xp.take_along_axis(event_tic, event[:, None], axis=1)[:, 0]
             happens = (rank < num_events) & (health > 0)  # nothing reaches a dead agent
             lava = happens & (event == 0)
             correct = happens & (event > 0) & ((event % 2 == 1) == totem_green)  # even items (odd events) are green
             wrong = happens & (event > 0) & ~correct
-            raised = rules.at_most(xp, health + ITEM_HEALTH, MAX_HEALTH)
+            raised = arrays.at_most(xp, health + ITEM_HEALTH, MAX_HEALTH)
             reward = reward + self._correct_item_reward * xp.astype(correct & (raised > health), xp.float64)
             hurt = lava | wrong
             hit = xp.where(lava, LAVA_DAMAGE, xp.where(wrong, wrong_damage, 0))
             health = xp.where(correct, raised, health - hit)
             # Lava hurts before the tic's count-down, an item's damage after it.
             before_count = xp.astype(lava, xp.int64)
-            counted = rules.count_down(xp, damage, tic - settled - before_count)
-            damage = xp.where(hurt, rules.at_most(xp, counted + hit, rules.MAX_DAMAGE_COUNT) - before_count, damage)
+            counted = arrays.count_down(xp, damage, tic - settled - before_count)
+            damage = xp.where(hurt, arrays.at_most(xp, counted + hit, arrays.MAX_DAMAGE_COUNT) - before_count, damage)
             settled = xp.where(hurt, tic, settled)
-        state["damage_count"] = rules.count_down(xp, damage, tics - 1 - settled)
-        state["bonus_count"] = rules.bonus_after_step(xp, state["bonus_count"], xp.max(first_tic, axis=1), tics)
+        state["damage_count"] = arrays.count_down(xp, damage, tics - 1 - settled)
+        state["bonus_count"] = arrays.bonus_after_step(xp, state["bonus_count"], xp.max(first_tic, axis=1), tics)
         dead = health <= 0
         state["health"] = health
         shown = xp.concat([shown[:, :1], shown[:, 1:] & ~picked], axis=1)
         # One item every 30 tics (never more than one per 4-tic step after the start).
-        due = rules.at_most(xp, START_ITEMS + state["steps"] * doom.TICS_PER_STEP // SPAWN_EVERY_TICS, self._item_cap)
+        due = arrays.at_most(xp, START_ITEMS + state["steps"] * doom.TICS_PER_STEP // SPAWN_EVERY_TICS, self._item_cap)
         spawn = ~dead & (state["items_spawned"] < due)
         # On numpy most steps spawn nothing: skip the draws then. On torch, draw
         # for every env and keep the spawns (asking whether any is due would wait for the GPU).
-        if not rules.on_host(xp) or bool(xp.any(spawn)):
+        if not arrays.on_host(xp) or bool(xp.any(spawn)):
             item = state["items_spawned"]
             xy, drawn = self._free_positions(xp, state, state["key"], item[:, None], path[:, -1])
-            slot = rules.one_hot(xp, item + 1, 1 + POOL_SIZE) & (spawn & drawn[:, 0])[:, None]
+            slot = arrays.one_hot(xp, item + 1, 1 + POOL_SIZE) & (spawn & drawn[:, 0])[:, None]
             state["object_xy"] = xp.where(slot[:, :, None], xy, state["object_xy"])
             shown = shown | slot
             state["items_spawned"] = item + xp.astype(spawn, xp.int64)
@@ -261,7 +261,7 @@ class TwoColour(core.MazeRules):
         ``(xy (B, K, 2), drawn (B, K))``, ``drawn`` false where none was.
         """
         batch, count = items.shape
-        device = rules.device(items)
+        device = arrays.device(items)
         candidate = xp.arange(ITEM_CANDIDATES, dtype=xp.int64, device=device)[None, None, :, None]
         axis = xp.arange(2, dtype=xp.int64, device=device)[None, None, None, :]
         half = GRID_SIZE * CELL_SIZE / 2
@@ -273,7 +273,7 @@ class TwoColour(core.MazeRules):
         xys, drawns = [], []
         for begin in range(0, count, chunk):
             part = items[:, begin : begin + chunk]
-            u = rules.uniform(xp, keys[:, None, None, None], rules.DRAW_ITEM, part[:, :, None, None], candidate, axis)
+            u = arrays.uniform(xp, keys[:, None, None, None], arrays.DRAW_ITEM, part[:, :, None, None], candidate, axis)
             points = (2 * u - 1) * half  # (B, k, candidates, 2)
             # An armour's square fits beside a wall box where it is clear of it in x or in y.
             gap_x = xp.abs(points[..., 0:1] - boxes[..., 0]) - boxes[..., 2]
