@@ -146,3 +146,24 @@ def test_a2c_trains_on_vizdoom_and_evaluates_there(vizdoom, tmp_path):
     assert result["env_id"] == "vizdoom:two_color/1@vizdoom"
     assert result["train"]["configs"] == [0, 0, 1, 1] and result["train"]["metric"] == "duration"
 
+
+
+def _doom_processes() -> set[int]:
+    import subprocess
+
+    listing = subprocess.run(["ps", "-eo", "pid,args"], capture_output=True, text=True).stdout
+    return {int(line.split()[0]) for line in listing.splitlines()[1:] if "vizdoom/vizdoom " in line}
+
+
+def test_a_close_after_an_interrupted_step_ends_its_workers_and_their_doom_processes(vizdoom, monkeypatch):
+    before = _doom_processes()
+    monkeypatch.setattr(vizdoom_env.ReleasedVectorEnv, "pending_close_timeout", 2.0)
+    envs = vizdoom_env.make_vector_env(2, "two_colour", 1, released_dir=RELEASED, num_configs=2, freedoom="vizdoom")
+    envs.reset(seed=0)
+    assert len(_doom_processes() - before) == 2  # one game each
+    # Ctrl-C inside step: one worker's reply read, the other's not. gymnasium's close would wait forever.
+    envs.step_async(np.array([FORWARD, FORWARD]))
+    envs.parent_pipes[0].recv()
+    envs.close()
+    assert not any(process.is_alive() for process in envs.processes)
+    assert not _doom_processes() - before

@@ -38,9 +38,12 @@ import functools
 import hashlib
 import io
 import json
+import multiprocessing
 import os
 import pathlib
+import signal
 import tarfile
+import threading
 import urllib.error
 import urllib.request
 from collections.abc import Sequence
@@ -210,6 +213,10 @@ def episode_metrics(scenario: str, rewards: Sequence[float], steps: int, difficu
     raise ValueError(f"the paper released no {scenario!r} mazes")
 
 
+def _exit_on_sigterm(signum, frame):
+    raise SystemExit(0)
+
+
 def maze_seed(seed: int, index: int) -> int:
     """Doom's seed for maze ``index`` of an env seeded ``seed``: other seeds, other episodes of the same mazes."""
     return seed * 1000 + index
@@ -232,6 +239,10 @@ class ReleasedMazeEnv(gym.Env):
         self.observation_space = gym.spaces.Box(0, 255, (FRAME_SIZE[1], FRAME_SIZE[0], 3), np.uint8)
         self.action_space = gym.spaces.Discrete(len(LIMITED_ACTIONS))
         self._games: dict[int, object] = {}
+        if multiprocessing.parent_process() is not None and threading.current_thread() is threading.main_thread():
+            # In a vector env's worker, terminated on close: leave through gymnasium's worker's `finally`,
+            # which closes the env and so its Doom processes.
+            signal.signal(signal.SIGTERM, _exit_on_sigterm)
         self._seed = 0
         self._game = None
         self._rewards: list[float] = []
@@ -341,7 +352,25 @@ def make_vector_env(num_envs: int, scenario: str, difficulty: int | None = None,
         for mazes, first in env_mazes(num_envs, num_configs, order)
     ]
     # Spawned workers: the parent may hold torch's threads, which a fork would copy half-made.
-    return gym.vector.AsyncVectorEnv(makers, context="spawn", autoreset_mode=modes[autoreset_mode])
+    return ReleasedVectorEnv(makers, context="spawn", autoreset_mode=modes[autoreset_mode])
+
+
+class ReleasedVectorEnv(gym.vector.AsyncVectorEnv):
+    """gymnasium's ``AsyncVectorEnv``, but a close after an interrupted step does not wait forever.
+
+    Ctrl-C or SIGTERM in the middle of ``step`` (training saves a checkpoint
+    then) leaves some workers' replies read and others not: gymnasium's close
+    would wait for all of them. It waits :attr:`pending_close_timeout`
+    seconds, then terminates the workers, whose games close on the way out
+    (a Doom process outlives its worker otherwise).
+    """
+
+    pending_close_timeout = 10.0
+
+    def close_extras(self, timeout: float | None = None, terminate: bool = False) -> None:
+        if self._state != gym.vector.async_vector_env.AsyncState.DEFAULT and timeout is None:
+            timeout = self.pending_close_timeout
+        super().close_extras(timeout, terminate)
 
 
 def engine_id(scenario: str, difficulty: int, freedoom: str = "paper") -> str:
