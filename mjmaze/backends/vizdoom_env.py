@@ -37,7 +37,6 @@ from __future__ import annotations
 import functools
 import hashlib
 import io
-import json
 import multiprocessing
 import os
 import pathlib
@@ -256,10 +255,8 @@ class ReleasedMazeEnv(gym.Env):
         return self._games[index]
 
     def _health_now(self):
-        vzd = _vizdoom()
-        if vzd.GameVariable.HEALTH not in self._game.get_available_game_variables():
-            return None  # the released env pays for health only where the cfg reports it (Two-colour)
-        return self._game.get_game_variable(vzd.GameVariable.HEALTH)
+        # The released env pays for health only where the cfg reports it (Two-colour): known once per game.
+        return self._game.get_game_variable(self._health_variable) if self._health_variable is not None else None
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         super().reset(seed=seed)
@@ -271,6 +268,8 @@ class ReleasedMazeEnv(gym.Env):
         self._started = True
         self._game = self._game_for(self.mazes[self.position])
         self._game.new_episode()
+        health = _vizdoom().GameVariable.HEALTH
+        self._health_variable = health if health in self._game.get_available_game_variables() else None
         self._rewards, self._health = [], self._health_now()
         return frame(self._game), {}
 
@@ -375,4 +374,4 @@ class ReleasedVectorEnv(gym.vector.AsyncVectorEnv):
 
 def engine_id(scenario: str, difficulty: int, freedoom: str = "paper") -> str:
     """What a run on this engine played, as a run's ``env_id`` names mjmaze's version."""
-    return f"vizdoom:{RELEASED_FOLDERS[scenario]}/{difficulty}@{json.dumps(freedoom)[1:-1]}"
+    return f"vizdoom:{RELEASED_FOLDERS[scenario]}/{difficulty}@{freedoom}"
