@@ -148,22 +148,37 @@ def test_a2c_trains_on_vizdoom_and_evaluates_there(vizdoom, tmp_path):
 
 
 
-def _doom_processes() -> set[int]:
+def _doom_processes(parents: set[int]) -> set[int]:
+    """The Doom games these worker processes started (a run elsewhere on the machine has its own)."""
     import subprocess
 
-    listing = subprocess.run(["ps", "-eo", "pid,args"], capture_output=True, text=True).stdout
-    return {int(line.split()[0]) for line in listing.splitlines()[1:] if "vizdoom/vizdoom " in line}
+    listing = subprocess.run(["ps", "-eo", "pid,ppid,args"], capture_output=True, text=True).stdout
+    rows = (line.split(maxsplit=2) for line in listing.splitlines()[1:])
+    return {int(pid) for pid, ppid, args in rows if int(ppid) in parents and "vizdoom/vizdoom " in args}
+
+
+def _alive(pids: set[int]) -> set[int]:
+    """Those still running: gone from /proc, or a zombie waiting for its reaper, counts as ended."""
+    alive = set()
+    for pid in pids:
+        try:
+            state = pathlib.Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+        except (FileNotFoundError, ProcessLookupError):
+            continue
+        if state != "Z":
+            alive.add(pid)
+    return alive
 
 
 def test_a_close_after_an_interrupted_step_ends_its_workers_and_their_doom_processes(vizdoom, monkeypatch):
-    before = _doom_processes()
     monkeypatch.setattr(vizdoom_env.ReleasedVectorEnv, "pending_close_timeout", 2.0)
     envs = vizdoom_env.make_vector_env(2, "two_colour", 1, released_dir=RELEASED, num_configs=2, freedoom="vizdoom")
     envs.reset(seed=0)
-    assert len(_doom_processes() - before) == 2  # one game each
+    games = _doom_processes({process.pid for process in envs.processes})
+    assert len(games) == 2  # one game each
     # Ctrl-C inside step: one worker's reply read, the other's not. gymnasium's close would wait forever.
     envs.step_async(np.array([FORWARD, FORWARD]))
     envs.parent_pipes[0].recv()
     envs.close()
     assert not any(process.is_alive() for process in envs.processes)
-    assert not _doom_processes() - before
+    assert not _alive(games)
