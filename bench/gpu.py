@@ -116,7 +116,7 @@ def frames(device: str, quick: bool) -> dict:
     for scenario, kwargs in SETTINGS:
         batch = MazeBatchEnv(worlds, scenario, device=device, render_segmentation=True, **kwargs)
         batch.reset(seed=0)
-        num_configs = len(batch.task.configs)
+        num_configs = len(batch.rules.configs)
         cpus = []
         for i in range(worlds):  # seeded and offset as the batch's worlds are (tests/test_warp.py)
             env = mjmaze.load(scenario, task_kwargs={**kwargs, "first_config": i * num_configs // worlds % num_configs})

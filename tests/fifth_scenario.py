@@ -40,6 +40,6 @@ class Beacon(core.MazeRules):
 
 
 SCENARIO = registry.Scenario(
-    name="beacon", task=Beacon, gym_id="mjmaze_test/Beacon-v0", seed_code=1001, difficulty="size",
+    name="beacon", rules=Beacon, gym_id="mjmaze_test/Beacon-v0", seed_code=1001, difficulty="size",
     difficulties=(3, 4), metric="reached", metric_scale=100.0, metric_units="reached %", cell_size=1.0,
 )

@@ -116,3 +116,25 @@ def test_the_old_module_paths_import_for_one_more_release_with_a_warning():
     )
     result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stderr[-2000:]
+
+
+def test_the_core_is_rules_on_every_backend_and_the_old_task_name_still_reads_for_a_release():
+    import dataclasses
+
+    import gymnasium
+
+    import mjmaze
+    from mjmaze.game import core, registry
+
+    env = gymnasium.make(mjmaze.GYM_IDS["labyrinth"], size=5)
+    try:
+        assert isinstance(env.unwrapped.rules, core.MazeRules) and env.unwrapped.rules is env.unwrapped.task.rules
+    finally:
+        env.close()
+    declared = registry.get("labyrinth")
+    fields = {field.name: getattr(declared, field.name) for field in dataclasses.fields(declared)}
+    fields["task"] = fields.pop("rules")
+    with pytest.warns(DeprecationWarning, match="rules="):
+        assert registry.Scenario(**fields) == declared
+    with pytest.raises(TypeError, match="needs rules="):
+        registry.Scenario(**{**fields, "task": None})

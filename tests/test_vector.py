@@ -12,7 +12,7 @@ import pytest
 import mjmaze
 from mjmaze.backends import suite
 from mjmaze.backends.vector import SHARED_MEMORY_PREFIX, MazeVectorEnv, WorkerError
-from mjmaze.game import registry
+from mjmaze.game import core, registry
 from mjmaze.scenarios import labyrinth
 
 
@@ -26,7 +26,7 @@ class FailingLabyrinth(labyrinth.Labyrinth):
         return super().rules(xp, state, path)
 
 
-FAILING = dataclasses.replace(labyrinth.SCENARIO, name="failing_labyrinth", task=FailingLabyrinth,
+FAILING = dataclasses.replace(labyrinth.SCENARIO, name="failing_labyrinth", rules=FailingLabyrinth,
                               gym_id="mjmaze_test/FailingLabyrinth-v0", seed_code=1002)
 
 
@@ -77,16 +77,19 @@ def test_envs_start_on_different_configurations():
 
 
 def _run_to_time_limit(envs, num_envs):
-    for step in range(1, 526):
+    """The envs' last three steps before the 525-step limit: the clock set on, not 522 steps played
+    (every env is in this process: ``num_workers=0``)."""
+    envs._local._group.state["steps"][:] = core.EPISODE_STEPS - 3
+    for step in range(core.EPISODE_STEPS - 2, core.EPISODE_STEPS + 1):
         obs, rewards, terminated, truncated, infos = envs.step(np.full(num_envs, TURN_LEFT))
-        if step < 525:
+        assert (infos["step"] == step).all()
+        if step < core.EPISODE_STEPS:
             assert not truncated.any()
     return obs, rewards, terminated, truncated, infos
 
 
-@pytest.mark.slow
 def test_next_step_autoreset():
-    envs = MazeVectorEnv(2, "labyrinth", size=5, autoreset_mode="next_step")
+    envs = MazeVectorEnv(2, "labyrinth", size=5, autoreset_mode="next_step", num_workers=0)
     envs.reset(seed=1)
     obs, rewards, terminated, truncated, infos = _run_to_time_limit(envs, 2)
     assert truncated.all() and not terminated.any()
@@ -99,13 +102,12 @@ def test_next_step_autoreset():
     envs.close()
 
 
-@pytest.mark.slow
 def test_same_step_autoreset_reports_the_final_observation():
-    envs = MazeVectorEnv(2, "labyrinth", size=5, autoreset_mode="same_step")
+    envs = MazeVectorEnv(2, "labyrinth", size=5, autoreset_mode="same_step", num_workers=0)
     envs.reset(seed=1)
-    for _ in range(524):
-        obs, *_ = envs.step(np.full(2, TURN_LEFT))
-    before_end = obs.copy()
+    envs._local._group.state["steps"][:] = core.EPISODE_STEPS - 2
+    before_end, *_ = envs.step(np.full(2, TURN_LEFT))
+    before_end = before_end.copy()
     obs, rewards, terminated, truncated, infos = envs.step(np.full(2, TURN_LEFT))
     assert truncated.all()
     assert (infos["step"] == 0).all()  # already the new episode

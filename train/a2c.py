@@ -139,66 +139,149 @@ def training_envs(args: Args, device: torch.device) -> functools.partial:
     )
 
 
+@dataclasses.dataclass
+class _Rollout:
+    """One update's ``T`` steps of ``n`` envs: what the loss needs, and the episodes that ended."""
+
+    actions: torch.Tensor  #: ``(T, n)``, where the envs put their results (the GPU with the Warp backend)
+    rewards: torch.Tensor
+    dones: torch.Tensor
+    logits: list = dataclasses.field(default_factory=list)  #: each step's, with its graph (see :meth:`_Learner.rollout`)
+    values: list = dataclasses.field(default_factory=list)
+    finished: list = dataclasses.field(default_factory=list)  #: final infos of the episodes that ended
+    env_seconds: float = 0.0  #: of the rollout, in ``envs.step``
+
+
+class _Learner:
+    """The agent between updates: its network and optimizer, and the envs' last frame and memory."""
+
+    def __init__(self, args: Args, agent: Agent, optimizer: torch.optim.Optimizer, device: torch.device):
+        self.args, self.agent, self.optimizer, self.device = args, agent, optimizer, device
+        # The envs' results stay where the envs make them: the GPU with the Warp backend, else the host.
+        self.buffers = device if args.backend == "warp" else torch.device("cpu")
+        self.rollout_threads, self.update_threads = cpu_threads(args, device)
+
+    def restart(self, envs, seed: int) -> None:
+        """New episodes in every env, the memory wiped."""
+        self.obs, _ = envs.reset(seed=seed)
+        self.hidden = self.agent.initial_state(self.args.num_envs, self.device)
+        self.episode_starts = torch.ones(self.args.num_envs, dtype=torch.bool, device=self.buffers)
+
+    def rollout(self, envs) -> _Rollout:
+        """``num_steps`` steps of every env, actions sampled from the policy."""
+        shape = (self.args.num_steps, self.args.num_envs)
+        done = _Rollout(actions=torch.zeros(shape, dtype=torch.long, device=self.buffers),
+                        rewards=torch.zeros(shape, device=self.buffers), dones=torch.zeros(shape, device=self.buffers))
+        agent, device = self.agent, self.device
+        torch.set_num_threads(self.rollout_threads)
+        for t in range(self.args.num_steps):
+            # The rollout's forward pass is the update's: the parameters do
+            # not change within a rollout, so its graph is kept for the
+            # backward pass instead of being recomputed (the same gradients;
+            # tests/test_train.py checks it). The graph holds ~90 KB per frame.
+            features = agent.features(torch.as_tensor(self.obs).to(device))
+            logits, value, self.hidden = agent.step(features, self.hidden, self.episode_starts.to(device))
+            done.logits.append(logits)
+            done.values.append(value)
+            with torch.no_grad():
+                action = torch.multinomial(F.softmax(logits, dim=-1), 1).squeeze(1)
+            env_started = time.perf_counter()
+            action = action.to(self.buffers)
+            # The Warp backend takes the device's tensor, the CPU envs a numpy array.
+            self.obs, reward, terminated, truncated, infos = envs.step(
+                action if self.args.backend == "warp" else action.numpy())
+            done.env_seconds += time.perf_counter() - env_started
+            ended = torch.as_tensor(terminated | truncated)
+            done.actions[t] = action
+            done.rewards[t] = torch.as_tensor(reward)
+            done.dones[t] = ended
+            self.episode_starts = ended
+            if "final_info" in infos:
+                # One copy to the host per field (the Warp backend's are on the GPU), not one per value.
+                final = {k: torch.as_tensor(v).cpu() for k, v in infos["final_info"].items() if not k.startswith("_")}
+                for i in torch.nonzero(ended).flatten().tolist():
+                    done.finished.append({k: v[i].item() for k, v in final.items()})
+        return done
+
+    def update(self, rollout: _Rollout) -> dict:
+        """One A2C update from ``rollout``: the losses (tensors) and the gradient's norm before clipping."""
+        args, agent, device = self.args, self.agent, self.device
+        with torch.no_grad():
+            features = agent.features(torch.as_tensor(self.obs).to(device))
+            _, last_value, _ = agent.step(features, self.hidden, self.episode_starts.to(device))
+        torch.set_num_threads(self.update_threads)
+        returns = n_step_returns(rollout.rewards.to(device), rollout.dones.to(device), last_value, args.gamma)
+        losses = a2c_losses(torch.stack(rollout.logits), torch.stack(rollout.values), rollout.actions.to(device),
+                            returns, args.value_coef, args.entropy_coef)
+        # The rollout's graph, freed before the next rollout builds its own.
+        rollout.logits.clear()
+        rollout.values.clear()
+        self.optimizer.zero_grad()
+        losses["total"].backward()
+        grad_norm = torch.nn.utils.clip_grad_norm_(agent.parameters(), args.max_grad_norm)
+        self.optimizer.step()
+        self.hidden = self.hidden.detach()
+        return {**losses, "grad_norm": grad_norm}
+
+
+class _RunLog:
+    """Where an update's figures go: ``metrics.jsonl`` (one line each), TensorBoard and the progress bar."""
+
+    def __init__(self, args: Args, run_dir: pathlib.Path, step: int):
+        from torch.utils.tensorboard import SummaryWriter
+        from tqdm import tqdm
+
+        self.metric, self.scale, _ = suite.paper_metric(args.scenario)
+        # The field the paper's training curves plot, where it is not the metric (K-item's normalised return).
+        curve_field = published.curve_field(args.scenario)
+        self.curve_field = curve_field if curve_field != self.metric else None
+        self.curve_scale = published.curve_scale(args.scenario)
+        self.writer = SummaryWriter(run_dir / "tensorboard")
+        self.metrics_file = open(run_dir / "metrics.jsonl", "a")
+        self.bar = tqdm(total=args.total_steps, initial=step, unit="step", disable=not args.progress, dynamic_ncols=True)
+
+    def write(self, record: dict, finished: list[dict], steps: int) -> None:
+        """Logs one update's ``record``, with the means of the ``finished`` episodes; ``steps`` observations."""
+        metric, step = self.metric, record["step"]
+        if finished:
+            record["episode_return"] = float(np.mean([e["episode_return"] for e in finished]))
+            record[metric] = float(np.mean([e[metric] for e in finished])) * self.scale
+            if self.curve_field:
+                record[self.curve_field] = float(np.mean([e[self.curve_field] for e in finished])) * self.curve_scale
+        self.metrics_file.write(json.dumps(record) + "\n")
+        self.metrics_file.flush()
+        for key in ("policy_loss", "value_loss", "entropy"):
+            self.writer.add_scalar(f"losses/{key}", record[key], step)
+        self.writer.add_scalar("charts/SPS", record["sps"], step)
+        if finished:
+            self.writer.add_scalar("charts/episode_return", record["episode_return"], step)
+            self.writer.add_scalar(f"charts/{metric}", record[metric], step)
+        self.bar.update(steps)
+        self.bar.set_postfix(sps=f"{record['sps']:.0f}", **({metric: f"{record[metric]:.3g}"} if finished else {}))
+
+    def close(self) -> None:
+        self.bar.close()
+        self.writer.close()
+        self.metrics_file.close()
+
+
 def _loop(args, make_envs, envs, agent, optimizer, device, run_dir, step, update) -> pathlib.Path:
-    """The training loop; it owns ``envs`` (and rebuilds them with ``make_envs`` when a worker dies)."""
-    from torch.utils.tensorboard import SummaryWriter
-    from tqdm import tqdm
-
-    n, T = args.num_envs, args.num_steps
-    metric, scale, _ = suite.paper_metric(args.scenario)
-    # The field the paper's training curves plot, where it is not the metric (K-item's normalised return).
-    curve_field = published.curve_field(args.scenario) if published.curve_field(args.scenario) != metric else None
-    # Rollout buffers where the envs put their results (the GPU with the Warp backend).
-    buffers = device if args.backend == "warp" else torch.device("cpu")
-    actions = torch.zeros((T, n), dtype=torch.long, device=buffers)
-    rewards = torch.zeros((T, n), device=buffers)
-    dones = torch.zeros((T, n), device=buffers)
-
-    obs, _ = envs.reset(seed=args.seed + 1000 * update)
-    hidden = agent.initial_state(n, device)
-    episode_starts = torch.ones(n, dtype=torch.bool, device=buffers)
-    writer = SummaryWriter(run_dir / "tensorboard")
-    metrics_file = open(run_dir / "metrics.jsonl", "a")
+    """The training loop: rollout, update, log, checkpoint. It owns ``envs``, and rebuilds them with
+    ``make_envs`` when a worker dies."""
+    learner = _Learner(args, agent, optimizer, device)
+    learner.restart(envs, seed=args.seed + 1000 * update)
+    log = _RunLog(args, run_dir, step)
     next_checkpoint = (step // args.checkpoint_every + 1) * args.checkpoint_every
-    bar = tqdm(total=args.total_steps, initial=step, unit="step", disable=not args.progress, dynamic_ncols=True)
     # Ctrl-C and SIGTERM both end in a final checkpoint (installed explicitly:
     # a job started in the background may inherit an ignored SIGINT).
     previous_handlers = {sig: signal.signal(sig, _raise_stop) for sig in (signal.SIGINT, signal.SIGTERM)}
     stopped, failures, rebuilds = False, 0, 0
-    rollout_threads, update_threads = cpu_threads(args, device)
+    batch = args.num_envs * args.num_steps
     try:
         while step < args.total_steps:
             start_time = time.perf_counter()
-            finished = []  # final infos of the episodes that ended in this rollout
-            step_logits, step_values = [], []
-            env_seconds = 0.0  # of the rollout, in envs.step
-            torch.set_num_threads(rollout_threads)
             try:
-                for t in range(T):
-                    # The rollout's forward pass is the update's: the parameters do
-                    # not change within a rollout, so its graph is kept for the
-                    # backward pass instead of being recomputed (the same gradients;
-                    # tests/test_train.py checks it). The graph holds ~90 KB per frame.
-                    features = agent.features(torch.as_tensor(obs).to(device))
-                    logits, value, hidden = agent.step(features, hidden, episode_starts.to(device))
-                    step_logits.append(logits)
-                    step_values.append(value)
-                    with torch.no_grad():
-                        action = torch.multinomial(F.softmax(logits, dim=-1), 1).squeeze(1)
-                    env_started = time.perf_counter()
-                    action = action.to(buffers)
-                    obs, reward, terminated, truncated, infos = envs.step(action if args.backend == "warp" else action.numpy())
-                    env_seconds += time.perf_counter() - env_started
-                    ended = torch.as_tensor(terminated | truncated)
-                    actions[t] = action
-                    rewards[t] = torch.as_tensor(reward)
-                    dones[t] = ended
-                    episode_starts = ended
-                    if "final_info" in infos:
-                        # One copy to the host per field (the Warp backend's are on the GPU), not one per value.
-                        final = {k: torch.as_tensor(v).cpu() for k, v in infos["final_info"].items() if not k.startswith("_")}
-                        for i in torch.nonzero(ended).flatten().tolist():
-                            finished.append({k: v[i].item() for k, v in final.items()})
+                rollout = learner.rollout(envs)
             except WorkerError as error:
                 # The network and optimizer are intact: drop this rollout (its
                 # episodes are cut), rebuild the envs and start fresh episodes.
@@ -212,57 +295,25 @@ def _loop(args, make_envs, envs, agent, optimizer, device, run_dir, step, update
                     ) from None
                 print(f"step {step:,}: {error}; rebuilding the envs ({failures} of {MAX_ENV_FAILURES - 1} retries)",
                       file=sys.stderr)
-                del step_logits, step_values  # the cut rollout's graph
                 envs = make_envs()
                 rebuilds += 1
-                obs, _ = envs.reset(seed=args.seed + 1000 * update + rebuilds)
-                hidden = agent.initial_state(n, device)
-                episode_starts = torch.ones(n, dtype=torch.bool, device=buffers)
+                learner.restart(envs, seed=args.seed + 1000 * update + rebuilds)
                 continue
             failures = 0
             update_started = time.perf_counter()
-            with torch.no_grad():
-                features = agent.features(torch.as_tensor(obs).to(device))
-                _, last_value, _ = agent.step(features, hidden, episode_starts.to(device))
-            torch.set_num_threads(update_threads)
-            returns = n_step_returns(rewards.to(device), dones.to(device), last_value, args.gamma)
-            losses = a2c_losses(torch.stack(step_logits), torch.stack(step_values), actions.to(device), returns,
-                                args.value_coef, args.entropy_coef)
-            del step_logits, step_values
-            optimizer.zero_grad()
-            losses["total"].backward()
-            grad_norm = torch.nn.utils.clip_grad_norm_(agent.parameters(), args.max_grad_norm)
-            optimizer.step()
-            hidden = hidden.detach()
-
-            step += n * T
+            losses = learner.update(rollout)
+            step += batch
             update += 1
             now = time.perf_counter()
-            sps = n * T / (now - start_time)
-            record = {
-                "step": step, "update": update, "sps": sps,
+            log.write({
+                "step": step, "update": update, "sps": batch / (now - start_time),
                 # Where the update's time went: stepping the envs, the rest of the rollout, the update itself.
-                "env_seconds": env_seconds, "rollout_seconds": update_started - start_time,
+                "env_seconds": rollout.env_seconds, "rollout_seconds": update_started - start_time,
                 "update_seconds": now - update_started,
                 "policy_loss": losses["policy"].item(), "value_loss": losses["value"].item(),
-                "entropy": losses["entropy"].item(), "grad_norm": float(grad_norm), "episodes": len(finished),
-                "env_rebuilds": rebuilds,
-            }
-            if finished:
-                record["episode_return"] = float(np.mean([e["episode_return"] for e in finished]))
-                record[metric] = float(np.mean([e[metric] for e in finished])) * scale
-                if curve_field:
-                    record[curve_field] = float(np.mean([e[curve_field] for e in finished])) * published.curve_scale(args.scenario)
-            metrics_file.write(json.dumps(record) + "\n")
-            metrics_file.flush()
-            for key in ("policy_loss", "value_loss", "entropy"):
-                writer.add_scalar(f"losses/{key}", record[key], step)
-            writer.add_scalar("charts/SPS", sps, step)
-            if finished:
-                writer.add_scalar("charts/episode_return", record["episode_return"], step)
-                writer.add_scalar(f"charts/{metric}", record[metric], step)
-            bar.update(n * T)
-            bar.set_postfix(sps=f"{sps:.0f}", **({metric: f"{record[metric]:.3g}"} if finished else {}))
+                "entropy": losses["entropy"].item(), "grad_norm": float(losses["grad_norm"]),
+                "episodes": len(rollout.finished), "env_rebuilds": rebuilds,
+            }, rollout.finished, batch)
             if step >= next_checkpoint:
                 _save(args, agent, optimizer, step, update, run_dir)
                 next_checkpoint += args.checkpoint_every
@@ -272,9 +323,7 @@ def _loop(args, make_envs, envs, agent, optimizer, device, run_dir, step, update
         envs.close()
         for sig, handler in previous_handlers.items():
             signal.signal(sig, handler)
-        bar.close()
-        writer.close()
-        metrics_file.close()
+        log.close()
     path = _save(args, agent, optimizer, step, update, run_dir)
     print(f"{'stopped' if stopped else 'done'} at step {step:,}; checkpoint {path}")
     if stopped:

@@ -135,4 +135,4 @@ def curve_units(name: str) -> str:
 
 def landmark(name: str) -> str:
     """What the analysis marks the first sighting of: the scenario's object 0."""
-    return of(name).landmark or registry.get(name).task.objects[0].name
+    return of(name).landmark or registry.get(name).rules.objects[0].name

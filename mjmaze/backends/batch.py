@@ -126,26 +126,29 @@ class BatchEnv(gym.vector.VectorEnv):
         self,
         num_envs: int,
         scenario: str,
-        task: core.MazeRules,
+        rules: core.MazeRules,
         view: look.View,
         autoreset_mode: str | AutoresetMode,
         render_modes: Sequence[str],
     ) -> None:
-        """Checks ``num_envs`` and ``autoreset_mode`` and sets the spaces and metadata of envs of ``task``'s
-        rules whose frames look as ``view`` says."""
+        """Checks ``num_envs`` and ``autoreset_mode`` and sets the spaces and metadata of envs playing
+        ``rules`` whose frames look as ``view`` says."""
         if not isinstance(num_envs, (int, np.integer)) or isinstance(num_envs, bool) or num_envs < 1:
             raise ValueError(f"num_envs must be a positive integer, got {num_envs!r}")
         mode = parse_autoreset_mode(autoreset_mode)
         self.num_envs = int(num_envs)
         self.scenario = scenario
+        #: The scenario's core (:class:`mjmaze.game.core.MazeRules`): its configurations, actions and rules,
+        #: the same object on every backend (a gymnasium env's ``rules`` too).
+        self.rules = rules
         self.autoreset_mode = mode
         self.metadata = {"autoreset_mode": mode, "render_modes": list(render_modes), "render_fps": core.STEPS_PER_SECOND}
         self.single_observation_space = gym.spaces.Box(0, 255, view.frame_shape, np.uint8)
-        self.single_action_space = gym.spaces.Discrete(len(task.actions))
+        self.single_action_space = gym.spaces.Discrete(len(rules.actions))
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         #: The names and Python types of the ``info`` fields, in order (:meth:`mjmaze.game.core.MazeRules.info_fields`).
-        self.info_fields: dict[str, type] = task.info_fields()
+        self.info_fields: dict[str, type] = rules.info_fields()
         self.closed = False
 
     @property

@@ -32,6 +32,8 @@ class MazeEnv(gym.Env):
         self.render_mode = render_mode
         self._env = suite.load(scenario, task_kwargs)
         self.task: base.MazeTask = self._env.task
+        #: The scenario's core (:class:`mjmaze.game.core.MazeRules`), as every backend's envs expose it.
+        self.rules: core.MazeRules = self.task.rules
         self.physics: physics.MazePhysics = self._env.physics
         pixels = self._env.observation_spec()["pixels"]
         self.observation_space = gym.spaces.Box(0, 255, pixels.shape, np.uint8)

@@ -64,7 +64,7 @@ def paper_metric(name: str) -> tuple[str, float, str]:
 def default_difficulty(name: str) -> int:
     """The difficulty scenario ``name``'s rules take when given none (its ``size``, ``num_items``, ...)."""
     scenario = registry.get(name)
-    return inspect.signature(scenario.task.__init__).parameters[scenario.difficulty].default
+    return inspect.signature(scenario.rules.__init__).parameters[scenario.difficulty].default
 
 
 def _parameters(function, skip=("self", "kwargs", "difficulty", "layout")) -> tuple[str, ...]:
@@ -74,7 +74,7 @@ def _parameters(function, skip=("self", "kwargs", "difficulty", "layout")) -> tu
 def task_kwarg_names(name: str) -> tuple[str, ...]:
     """The task arguments scenario ``name`` accepts: its rules' (its own, then every scenario's), the
     view's (:data:`VIEW_ARGUMENTS`) and ``random``."""
-    return (_parameters(registry.get(name).task.__init__) + _parameters(core.MazeRules.__init__) + VIEW_ARGUMENTS
+    return (_parameters(registry.get(name).rules.__init__) + _parameters(core.MazeRules.__init__) + VIEW_ARGUMENTS
             + ("random",))
 
 
@@ -100,7 +100,7 @@ def _split(name: str, task_kwargs: dict | None) -> tuple[dict, dict, dict]:
 def make_task(name: str, task_kwargs: dict | None = None) -> base.MazeTask:
     """The dm_control task of scenario ``name`` (no physics, no rendering yet); checks its arguments."""
     rules_kwargs, view_kwargs, own = _split(name, task_kwargs)
-    return base.MazeTask(registry.get(name).task(**rules_kwargs), look.View(**view_kwargs), **own)
+    return base.MazeTask(registry.get(name).rules(**rules_kwargs), look.View(**view_kwargs), **own)
 
 
 def make_rules(name: str, task_kwargs: dict | None = None) -> core.MazeRules:
@@ -110,7 +110,7 @@ def make_rules(name: str, task_kwargs: dict | None = None) -> core.MazeRules:
     rules' (the view's are :func:`make_view`'s; ``random``, the seed of a
     dm_control task's episodes, has no use here: a batch env seeds its envs at ``reset``).
     """
-    return registry.get(name).task(**_split(name, task_kwargs)[0])
+    return registry.get(name).rules(**_split(name, task_kwargs)[0])
 
 
 def make_view(name: str, task_kwargs: dict | None = None) -> look.View:

@@ -30,6 +30,7 @@ memory.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import multiprocessing as mp
 import multiprocessing.connection
 import os
@@ -94,6 +95,19 @@ def _attach(name: str) -> shared_memory.SharedMemory:
     return shared_memory.SharedMemory(name=name)
 
 
+@dataclasses.dataclass(frozen=True)
+class _Share:
+    """What one process (a worker, or the calling process) needs to build its envs; pickled to a worker."""
+
+    env_ids: list[int]  #: its envs' slots of the shared arrays (consecutive)
+    first_configs: list[int]  #: where each of them starts cycling through the configurations
+    #: The declaration, not a name: a scenario registered at run time in the parent exists in a
+    #: spawned worker only once it is registered there.
+    scenario: registry.Scenario
+    task_kwargs: dict
+    same_step: bool
+
+
 class _SharedGroup:
     """The envs one process steps (a worker's share, or the calling process's): an
     :class:`mjmaze.backends.group.EnvGroup` and its slots of the shared arrays.
@@ -104,8 +118,8 @@ class _SharedGroup:
     :func:`mjmaze.backends.batch.autoreset_step`'s, over this group (a :class:`mjmaze.backends.batch.Simulator`).
     """
 
-    def __init__(self, arrays: dict[str, np.ndarray], slots: list[int], first_configs: list[int], scenario: str,
-                 task_kwargs: dict, same_step: bool):
+    def __init__(self, arrays: dict[str, np.ndarray], share: _Share):
+        slots, same_step = share.env_ids, share.same_step
         self._obs, self._actions = arrays["obs"], arrays["actions"]
         scalars = arrays["scalars"]
         self._columns = {name: scalars[name] for name in scalars.dtype.names}
@@ -116,10 +130,11 @@ class _SharedGroup:
         self._slots = np.array(slots)
         self._share = slice(slots[0], slots[-1] + 1)  # a group's slots are consecutive
         self._rows = list(range(len(slots)))
-        rules, view = suite.make_rules(scenario, task_kwargs), suite.make_view(scenario, task_kwargs)
+        name, task_kwargs = share.scenario.name, share.task_kwargs
+        rules, view = suite.make_rules(name, task_kwargs), suite.make_view(name, task_kwargs)
         # Unseeded envs draw their keys as a dm_control task with random=None does.
         keys = batch.seed_keys([None] * len(slots))
-        self._group = EnvGroup(rules, view, base.make_physics(rules, view, len(slots)), keys, first_configs)
+        self._group = EnvGroup(rules, view, base.make_physics(rules, view, len(slots)), keys, share.first_configs)
         self._ended = np.zeros(len(slots), dtype=bool)  # next-step mode: the env resets on its next step
 
     def reset(self, seeds: list[int] | None) -> None:
@@ -191,21 +206,17 @@ def _poll_then_block(conn, poll_seconds: float) -> None:
     conn.poll(None)
 
 
-def _worker(worker_id, conn, shm_name, layout, env_ids, first_configs, scenario, task_kwargs, same_step, poll_seconds):
-    """A worker's loop: build its envs, then answer step / reset / close commands.
-
-    ``scenario`` is the declaration (:class:`mjmaze.game.registry.Scenario`), not a
-    name: a scenario registered at run time in the parent exists in a spawned
-    worker only once it is registered there.
-    """
+def _worker(worker_id: int, conn, shm_name: str, layout: dict, share: _Share, poll_seconds: float):
+    """A worker's loop: build its envs (``share``) on the shared arrays (``shm_name`` laid out as
+    ``layout``), then answer step / reset / close commands."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
     segment = _attach(shm_name)
     arrays = _views(layout, segment.buf)
     busy = arrays["busy_seconds"]
     group = None
     try:
-        suite.register(scenario)
-        group = _SharedGroup(arrays, env_ids, first_configs, scenario.name, task_kwargs, same_step)
+        suite.register(share.scenario)
+        group = _SharedGroup(arrays, share)
         conn.send(None)
         clock = time.perf_counter
         while True:
@@ -241,14 +252,14 @@ def _main_module_hidden(scenario: registry.Scenario):
 
     ``spawn`` runs the parent's main script again in every worker, so that
     objects it defines can be unpickled there. A worker needs nothing from it
-    unless the scenario's task class is defined there; a training script's
+    unless the scenario's rules class is defined there; a training script's
     ``__main__`` would bring torch into every worker (~500 MB each), and code
     typed into ``python -`` cannot be re-imported at all. Python has no switch
     for this: multiprocessing reads ``sys.modules["__main__"]`` when a process
     starts, so a bare module stands in for it meanwhile.
     """
     main = sys.modules.get("__main__")
-    if main is None or scenario.task.__module__ == "__main__":
+    if main is None or scenario.rules.__module__ == "__main__":
         yield
         return
     sys.modules["__main__"] = types.ModuleType("__main__")
@@ -307,8 +318,8 @@ class MazeVectorEnv(batch.BatchEnv):
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
         # Checks the arguments here, in this process, and tells shapes and info fields.
-        probe = suite.make_rules(scenario, task_kwargs)
-        self._setup(num_envs, scenario, probe, suite.make_view(scenario, task_kwargs), autoreset_mode,
+        rules = suite.make_rules(scenario, task_kwargs)
+        self._setup(num_envs, scenario, rules, suite.make_view(scenario, task_kwargs), autoreset_mode,
                     render_modes=["rgb_array"])
         self.render_mode = render_mode
         usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
@@ -318,7 +329,7 @@ class MazeVectorEnv(batch.BatchEnv):
         if num_workers < (0 if step_in_caller else 1):
             raise ValueError(f"num_workers must be >= {0 if step_in_caller else 1}, got {num_workers}")
 
-        num_configs = len(probe.configs)
+        num_configs = len(rules.configs)
         first = task_kwargs.pop("first_config", 0)
         self._copy = copy
         self._timeout = float(timeout)
@@ -348,18 +359,17 @@ class MazeVectorEnv(batch.BatchEnv):
         shares = [ids.tolist() for ids in np.array_split(np.arange(self.num_envs), num_workers + step_in_caller)]
         self._worker_envs = shares[:num_workers]
         offsets = batch.first_configs(first, self.num_envs, num_configs)
-        same_step = self.same_step
+        declaration = registry.get(scenario)
+        share_of = [_Share(ids, [offsets[i] for i in ids], declaration, task_kwargs, self.same_step) for ids in shares]
         self._conns, self._processes = [], []
         self._local: _SharedGroup | None = None
-        declaration = registry.get(scenario)
         with _main_module_hidden(declaration):
-            for worker_id, env_ids in enumerate(self._worker_envs):
+            for worker_id in range(num_workers):
                 parent_end, child_end = ctx.Pipe()
                 process = ctx.Process(
                     target=_worker,
                     name=f"mjmaze-worker-{worker_id}",
-                    args=(worker_id, child_end, self._shm.name, layout, env_ids, [offsets[i] for i in env_ids],
-                          declaration, task_kwargs, same_step, self._poll_seconds),
+                    args=(worker_id, child_end, self._shm.name, layout, share_of[worker_id], self._poll_seconds),
                     daemon=True,
                 )
                 process.start()
@@ -368,8 +378,7 @@ class MazeVectorEnv(batch.BatchEnv):
                 self._processes.append(process)
         try:
             if step_in_caller:  # built while the workers build theirs
-                local = shares[-1]
-                self._local = _SharedGroup(self._arrays, local, [offsets[i] for i in local], scenario, task_kwargs, same_step)
+                self._local = _SharedGroup(self._arrays, share_of[-1])
             self._collect()  # every worker has built its envs
             # Every process has mapped the segment now: its name can go. The
             # memory lives until the last mapping does, so nothing is left in

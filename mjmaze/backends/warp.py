@@ -35,6 +35,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import gc
+import warnings
 from collections.abc import Callable
 from typing import Any
 
@@ -62,21 +63,21 @@ _CONTACTS_PER_WORLD = 32
 _EAGER_STEPS = 2
 
 
-def build_model(task: core.MazeRules, view: look.View) -> tuple[mujoco.MjModel, ArenaIds, np.ndarray, np.ndarray]:
-    """The task's arena as one MuJoCo model for all worlds, with a wall mesh per layout (:class:`mjmaze.build.arena.Arena`).
+def build_model(rules: core.MazeRules, view: look.View) -> tuple[mujoco.MjModel, ArenaIds, np.ndarray, np.ndarray]:
+    """The scenario's arena as one MuJoCo model for all worlds, with a wall mesh per layout (:class:`mjmaze.build.arena.Arena`).
 
     Returns ``(model, ids, mesh_of_config (C,), box_z_of_config (C, boxes))``:
     the model's parts, which mesh draws configuration ``c``'s walls and where
     its wall boxes stand (an absent wall's box below the floor).
     """
-    # One mesh per distinct wall layout among the task's configurations.
-    all_configs = [task.configs[i] for i in range(len(task.configs))]
+    # One mesh per distinct wall layout among the scenario's configurations.
+    all_configs = [rules.configs[i] for i in range(len(rules.configs))]
     layouts: dict[bytes, int] = {}
     layout_of_config = [layouts.setdefault(c.layout_key(), len(layouts)) for c in all_configs]
     first_of_layout: dict[int, object] = {}
     for config, layout in zip(all_configs, layout_of_config):
         first_of_layout.setdefault(layout, config)
-    model, ids = Arena(task, view, layouts=list(first_of_layout.values())).compile()
+    model, ids = Arena(rules, view, layouts=list(first_of_layout.values())).compile()
     mesh_of_config = ids.wall_meshes[layout_of_config].astype(np.int32)
     # Boxes follow h_walls then v_walls (walls.wall_segments).
     present = np.array([np.concatenate([c.h_walls.ravel(), c.v_walls.ravel()]) for c in all_configs], dtype=bool)
@@ -145,13 +146,13 @@ class MazeBatchEnv(batch.BatchEnv):
         wp.config.log_level = max(wp.config.log_level, wp.LOG_WARNING)
         wp.init()
         first = int(task_kwargs.pop("first_config", 0))
-        self.task = task = suite.make_rules(scenario, task_kwargs)
+        rules = suite.make_rules(scenario, task_kwargs)
         self.view = view = suite.make_view(scenario, task_kwargs)
-        self._setup(num_envs, scenario, task, view, autoreset_mode, render_modes=[])
+        self._setup(num_envs, scenario, rules, view, autoreset_mode, render_modes=[])
         n = self.num_envs
         self.device = torch.device(device)
         if restart_by_index is None:
-            restart_by_index = task.costly_start and self.device.type == "cpu"
+            restart_by_index = rules.costly_start and self.device.type == "cpu"
         self.restart_by_index = bool(restart_by_index)
         if cuda_graph and self.device.type != "cuda":
             raise ValueError(f"cuda_graph=True needs a CUDA device; got device={str(device)!r}")
@@ -168,28 +169,28 @@ class MazeBatchEnv(batch.BatchEnv):
         self.xp = arrays.namespace(torch.zeros(1))
         height, width = view.height, view.width
 
-        mjm, ids, mesh_of_config, box_z = build_model(task, view)
+        mjm, ids, mesh_of_config, box_z = build_model(rules, view)
         self._host_model = mjm
         dev = self.device
-        table = task.config_arrays([task.configs[i] for i in range(len(task.configs))])
+        table = rules.config_arrays([rules.configs[i] for i in range(len(rules.configs))])
         self._config_table = {name: torch.as_tensor(value, device=dev) for name, value in table.items()}
         self._mesh_of_config = torch.as_tensor(mesh_of_config, device=dev)
         self._box_z = torch.as_tensor(box_z, device=dev)
-        num_configs = len(task.configs)
+        num_configs = len(rules.configs)
         self._first = torch.tensor(batch.first_configs(first, n, num_configs), device=dev)
 
         self._box_ids = torch.as_tensor(ids.wall_boxes, device=dev)
         self._wall_visual = ids.wall_visual
         self._object_ids = torch.as_tensor(ids.objects, dtype=torch.long, device=dev)
-        self._object_z = torch.tensor([obj.z for obj in task.objects], dtype=torch.float32, device=dev)
+        self._object_z = torch.tensor([obj.z for obj in rules.objects], dtype=torch.float32, device=dev)
         # What Doom draws beyond the scene, for every world at once: the CPU envs' pipeline.
-        self._pipeline = look.FramePipeline(self.xp, dev, view, task, mjm, ids)
+        self._pipeline = look.FramePipeline(self.xp, dev, view, rules, mjm, ids)
         self._sprite_ids = torch.as_tensor(ids.sprites, dtype=torch.long, device=dev)
         colliding = np.flatnonzero(ids.collision >= 0)
         self._colliding = torch.as_tensor(colliding, dtype=torch.long, device=dev)
         self._collision_ids = torch.as_tensor(ids.collision[colliding], dtype=torch.long, device=dev)
         self._timestep = float(mjm.opt.timestep)
-        self._actions = torch.tensor(task.actions, dtype=torch.float64, device=dev)  # (A, 2): forward, turn
+        self._actions = torch.tensor(rules.actions, dtype=torch.float64, device=dev)  # (A, 2): forward, turn
 
         textured = view.textured
         with wp.ScopedDevice(self._wp_device):
@@ -239,6 +240,14 @@ class MazeBatchEnv(batch.BatchEnv):
         self._bob = torch.zeros(n, dtype=torch.float64, device=dev)  # Doom's walking bob of the last tic
         self._obs = torch.zeros((n, height, width, 3), dtype=torch.uint8, device=dev)
         self.state: dict[str, torch.Tensor] | None = None
+
+    @property
+    def task(self) -> core.MazeRules:
+        """0.1's name of :attr:`rules`, kept one more release with a ``DeprecationWarning`` (a CPU env's
+        ``task`` is its dm_control task, so one name meant two things)."""
+        warnings.warn("MazeBatchEnv.task is MazeBatchEnv.rules since mjmaze 0.2; .task goes in 0.3",
+                      DeprecationWarning, stacklevel=2)
+        return self.rules
 
     # -- gymnasium API ------------------------------------------------------
 
@@ -343,7 +352,7 @@ class MazeBatchEnv(batch.BatchEnv):
         """Every env's tics and rules (an env not ``playing`` restarts now: its outcome is masked out)."""
         self._advance_physics(self._actions[actions, 0], self._actions[actions, 1])
         state = dict(self.state)
-        outcome = self.task.step_state(self.xp, state, self._path)
+        outcome = self.rules.step_state(self.xp, state, self._path)
         self._keep_state(state)
         return outcome
 
@@ -420,11 +429,11 @@ class MazeBatchEnv(batch.BatchEnv):
 
     def _start_rows(self, envs, restart: torch.Tensor) -> None:
         """:meth:`_start_episodes` worked out for ``envs`` (indices, or every env) and kept where ``restart`` is set."""
-        xp, task = self.xp, self.task
+        xp, rules = self.xp, self.rules
         episodes = self._episodes[envs]
-        keys = task.episode_keys(xp, self._seed_keys[envs], episodes)
-        config_index = task.config_indices(xp, keys, episodes, first=self._first[envs])
-        start = task.start_state(xp, {name: value[config_index] for name, value in self._config_table.items()}, keys)
+        keys = rules.episode_keys(xp, self._seed_keys[envs], episodes)
+        config_index = rules.config_indices(xp, keys, episodes, first=self._first[envs])
+        start = rules.start_state(xp, {name: value[config_index] for name, value in self._config_table.items()}, keys)
         if self.state is None:  # the first reset: the tensors every later step writes into
             self.state = {name: value.clone() for name, value in start.items()}
         elif isinstance(envs, slice):  # every env worked out: the start where ``restart`` is set
@@ -528,10 +537,10 @@ class MazeBatchEnv(batch.BatchEnv):
 
     def _infos(self, mask: torch.Tensor | None = None) -> dict:
         """The info fields of every env (tensors ``(N,)``), each with its ``_field`` mask (``mask``, default all)."""
-        task, state = self.task, self.state
+        rules, state = self.rules, self.state
         qpos = self._qpos.double()
         yaw = core.wrap_yaw(torch, qpos[:, 2])
-        fields = core.episode_info(task.episode_metrics(state), qpos[:, 0], qpos[:, 1], yaw, state["steps"],
+        fields = core.episode_info(rules.episode_metrics(state), qpos[:, 0], qpos[:, 1], yaw, state["steps"],
                                    state["episode_return"], self._config_index)
         if mask is None:
             mask = torch.ones(self.num_envs, dtype=torch.bool, device=self.device)

@@ -411,18 +411,18 @@ class FramePipeline:
     every world (:mod:`mjmaze.backends.warp`). Made once per model and device.
     """
 
-    def __init__(self, xp, device, view: View, arena, model: mujoco.MjModel, ids):
-        """``arena``: what the scenario's arena holds (its ``objects``, ``layout``, whether it has a
-        ``pistol``: a :class:`mjmaze.game.core.MazeRules`); ``model`` and ``ids``: the arena compiled
+    def __init__(self, xp, device, view: View, rules, model: mujoco.MjModel, ids):
+        """``rules``: the scenario's core (:class:`mjmaze.game.core.MazeRules`: its ``objects``, ``layout``,
+        whether it has a ``pistol``); ``model`` and ``ids``: the arena compiled
         (:class:`mjmaze.build.arena.ArenaIds`)."""
         self._xp, self._device = xp, device
         self._width, self._height = view.width, view.height
         textured = view.textured
-        self.sprites = SpriteView(xp, device, model, arena.objects, ids, view.width) if textured else None
-        self.light = (DoomLight(xp, device, view.width, view.height, arena.layout.grid_size, arena.layout.cell_size)
+        self.sprites = SpriteView(xp, device, model, rules.objects, ids, view.width) if textured else None
+        self.light = (DoomLight(xp, device, view.width, view.height, rules.layout.grid_size, rules.layout.cell_size)
                       if textured else None)
         # The pistol is drawn where the released runs drew it: in the paper's look.
-        self._head_bob, self._pistol, self._flashes = view.head_bob, arena.pistol and textured, view.flashes
+        self._head_bob, self._pistol, self._flashes = view.head_bob, rules.pistol and textured, view.flashes
         self._tints: dict[tuple[int, int], tuple] = {}  # (damage, bonus) -> the flash's (rgb, alpha), on numpy
         if self.sprites is not None and len(self.sprites):
             self._sprite_objects = xp.asarray(self.sprites.object_index, device=device)

@@ -15,16 +15,18 @@ This module imports nothing of mjmaze, so any module may read it.
 from __future__ import annotations
 
 import dataclasses
+import warnings
 
 
-@dataclasses.dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class Scenario:
     """One scenario's declaration.
 
     Attributes:
       name: what :func:`mjmaze.load` takes, e.g. ``"labyrinth"``.
-      task: the scenario's class: a :class:`mjmaze.game.core.MazeRules` subclass (its dm_control task is a
-        :class:`mjmaze.backends.dm_task.MazeTask` holding one).
+      rules: the scenario's core, a :class:`mjmaze.game.core.MazeRules` subclass (its dm_control task is a
+        :class:`mjmaze.backends.dm_task.MazeTask` holding one; every env exposes the instance as ``rules``).
+        Until 0.3 it may still be passed as ``task=``, with a ``DeprecationWarning``.
       gym_id: the gymnasium id, e.g. ``"mjmaze/Labyrinth-v0"`` (the built-in
         scenarios' current ids come from :mod:`mjmaze.game.versions`).
       seed_code: an integer that enters every maze seed of the scenario. Fixed
@@ -46,7 +48,7 @@ class Scenario:
     """
 
     name: str
-    task: type
+    rules: type | None = None
     gym_id: str
     seed_code: int
     difficulty: str
@@ -57,6 +59,19 @@ class Scenario:
     cell_size: float
     item_codes: tuple[str, ...] | None = None
     imported_spawn_may_share_a_cell: bool = False
+    #: 0.1's name of ``rules``: accepted one more release (0.2), with a warning. An init-only
+    #: argument, not a field (``dataclasses.replace`` reads the class's ``None``).
+    task: dataclasses.InitVar[type | None] = None
+
+    def __post_init__(self, task: type | None) -> None:
+        if task is not None:
+            warnings.warn("Scenario(task=...) is Scenario(rules=...) since mjmaze 0.2; task= goes in 0.3",
+                          DeprecationWarning, stacklevel=3)
+            if self.rules is not None and self.rules is not task:
+                raise TypeError(f"scenario {self.name!r}: give rules=, not both rules= and task=")
+            object.__setattr__(self, "rules", task)
+        if self.rules is None:
+            raise TypeError(f"scenario {self.name!r} needs rules=: its MazeRules subclass")
 
 
 _SCENARIOS: dict[str, Scenario] = {}

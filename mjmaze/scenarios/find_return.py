@@ -97,7 +97,7 @@ class FindReturn(core.MazeRules):
 
 SCENARIO = registry.Scenario(
     name="find_return",
-    task=FindReturn,
+    rules=FindReturn,
     gym_id=versions.gym_id(versions.FIND_RETURN),
     seed_code=2,
     difficulty="size",

@@ -121,7 +121,7 @@ class KItem(core.MazeRules):
 
 SCENARIO = registry.Scenario(
     name="k_item",
-    task=KItem,
+    rules=KItem,
     gym_id=versions.gym_id(versions.K_ITEM),
     seed_code=3,
     difficulty="num_items",

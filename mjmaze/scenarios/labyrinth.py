@@ -72,7 +72,7 @@ class Labyrinth(core.MazeRules):
 
 SCENARIO = registry.Scenario(
     name="labyrinth",
-    task=Labyrinth,
+    rules=Labyrinth,
     gym_id=versions.gym_id(versions.LABYRINTH),
     seed_code=1,
     difficulty="size",

@@ -298,7 +298,7 @@ class TwoColour(core.MazeRules):
 
 SCENARIO = registry.Scenario(
     name="two_colour",
-    task=TwoColour,
+    rules=TwoColour,
     gym_id=versions.gym_id(versions.TWO_COLOUR),
     seed_code=4,
     difficulty="complexity",
