@@ -82,6 +82,8 @@ def test_the_paper_scenarios_report_their_documented_metrics(task_name):
         ("two_colour", {"complexity": 11}, "(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10)"),
         ("two_colour", {"size": 5}, "complexity"),  # Two-colour has no size: the error lists what it has
         ("two_colour", {"item_cap": 92}, "item_cap"),
+        ("labyrinth", {"room": "brick"}, "('stone', 'slime')"),
+        ("labyrinth", {"pistol": 1}, "pistol must be True or False"),
     ],
 )
 def test_bad_input_raises_a_value_error_listing_valid_choices(name, kwargs, expected):

@@ -18,7 +18,7 @@ from conftest import FORWARD, place
 import mjmaze
 from mjmaze.build import mjcf, palette, sprites, walls
 from mjmaze.drawing import render
-from mjmaze.game import core, doom, layouts
+from mjmaze.game import core, doom, layouts, registry
 from mjmaze.scenarios import find_return, k_item, two_colour
 
 STEP = -0.0004
@@ -115,17 +115,24 @@ def test_wall_textures_start_again_at_each_grid_line_as_the_released_blocks_do()
     assert np.allclose(coords[south, :, 0], 5 * 1.25 / 2 - quads[south, :, 0])
 
 
+def room_of(task) -> palette.Room:
+    """The room ``task``'s scenario declares (its view asks for none other)."""
+    return palette.ROOMS[registry.get(task.rules.scenario).room]
+
+
 def flat_views(task, centre, extent=1.0, pixels=128):
     """GL's frames (before Doom's light) of ``task``'s floor from above and ceiling from below: orthographic
     views of an ``extent``-metre square around ``centre``, image right along +x, image up along +y."""
-    root = ET.fromstring(mjcf.build_xml(task.rules.layout.grid_size, task.rules.layout.cell_size, room=palette.room_of(task.rules), width=task.view.width))
+    room = room_of(task)
+    root = ET.fromstring(mjcf.build_xml(task.rules.layout.grid_size, task.rules.layout.cell_size, room=room,
+                                        width=task.view.width))
     x, y = centre
     for name, z, axes in (("down", 0.5, "1 0 0 0 1 0"), ("up", 0.5, "1 0 0 0 -1 0")):
         ET.SubElement(root.find("worldbody"), "camera", name=name, pos=f"{x} {y} {z}", xyaxes=axes,
                       projection="orthographic", fovy=str(extent))
     root.find("visual/global").attrib.update(offwidth=str(pixels), offheight=str(pixels))
     model = mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
-    mjcf.paint_textures(model, palette.room_of(task.rules), task.rules.layout.cell_size)
+    mjcf.paint_textures(model, room, task.rules.layout.cell_size)
     # Whiter, so GL draws the texels themselves rather than a few dim grey levels
     # (GL's colour: the material's times its emission plus the ambient light).
     for name in ("floor", "ceiling"):
@@ -152,7 +159,7 @@ def test_floor_and_ceiling_show_their_flats_laid_as_in_the_released_maps(scenari
     offsets = (np.arange(pixels) + 0.5 - pixels / 2) * extent / pixels
     map_x = (centre[0] + offsets[None, :] - task.rules.layout.cell_size / 2) / doom.MAP_UNIT  # map units
     map_y = (centre[1] - offsets[:, None] - task.rules.layout.cell_size / 2) / doom.MAP_UNIT
-    for view, texture in ((floor, palette.room_of(task.rules).floor_texture), (ceiling, palette.room_of(task.rules).ceiling_texture)):
+    for view, texture in ((floor, room_of(task).floor_texture), (ceiling, room_of(task).ceiling_texture)):
         # mjmaze draws a flat in texels of 2 x 2 map units (mjcf.surface_texels).
         grey = sprites.surface(texture).astype(np.float64).mean(axis=2).reshape(32, 2, 32, 2).mean(axis=(1, 3))
 

@@ -41,8 +41,7 @@ def open_room(head_bob=None, width=320, height=180):
     bob = {} if head_bob is None else {"head_bob": head_bob}  # None: the default
     # ViZDoom's probe room had the pistol and no damaging floor: no flashes, the pistol drawn.
     task = suite.make_task("two_colour", {"complexity": 0, "item_cap": 0, "width": width, "height": height,
-                                          "random": 0, "flashes": False, **bob})
-    task.rules.pistol = True
+                                          "random": 0, "flashes": False, "pistol": True, **bob})
     env = base.make_environment(task)
     env.reset()
     # ViZDoom's start was (0, -500) facing 90 in the same room without the totem (at the centre here).

@@ -138,3 +138,17 @@ def test_the_core_is_rules_on_every_backend_and_the_old_task_name_still_reads_fo
         assert registry.Scenario(**fields) == declared
     with pytest.raises(TypeError, match="needs rules="):
         registry.Scenario(**{**fields, "task": None})
+
+
+def test_a_scenario_declares_its_room_and_an_unknown_one_is_refused_at_registration():
+    import dataclasses
+
+    from mjmaze.backends import suite
+    from mjmaze.game import registry
+
+    assert registry.get("two_colour").room == "slime" and registry.get("labyrinth").room == "stone"
+    odd = dataclasses.replace(registry.get("labyrinth"), name="odd", gym_id="mjmaze_test/Odd-v0", seed_code=1003,
+                              room="brick")
+    with pytest.raises(ValueError, match="room must be one of"):
+        suite.register(odd)
+    assert "odd" not in registry.names()

@@ -29,11 +29,10 @@ from mjmaze.scenarios import k_item, labyrinth, two_colour
 CLOSE = 9
 
 
-def empty_room(room: palette.Room, first_item: mjcf.ObjectGeom | None = None):
-    """A 10 m arena without walls inside (Two-colour at complexity 0) coloured as ``room``, objects
-    hidden; ``first_item`` replaces its first item."""
-    task = suite.make_task("two_colour", {"complexity": 0, "item_cap": 0, "random": 0})
-    task.rules.room = room
+def empty_room(room: str, first_item: mjcf.ObjectGeom | None = None):
+    """A 10 m arena without walls inside (Two-colour at complexity 0) coloured as ``room`` (a name of
+    :data:`mjmaze.build.palette.ROOMS`), objects hidden; ``first_item`` replaces its first item."""
+    task = suite.make_task("two_colour", {"complexity": 0, "item_cap": 0, "random": 0, "room": room})
     if first_item is not None:
         task.rules.objects = (two_colour.TOTEM, first_item, *two_colour.ITEMS[1:])
     env = base.make_environment(task)
@@ -58,7 +57,7 @@ def wall_grey(env, distance):
 
 
 def test_walls_are_as_dim_as_vizdooms_and_brighter_near_the_eye():
-    env = empty_room(palette.STONE_ROOM)
+    env = empty_room("stone")
     # ViZDoom, a STONE2 wall running north-south at sector light 160: 49, 38, 34, 30 grey at 0.5, 1, 2, 4 m.
     greys = [wall_grey(env, d) for d in (0.5, 1.0, 2.0, 4.0)]
     for got, doom in zip(greys, (49, 38, 34, 30)):
@@ -71,7 +70,7 @@ def test_walls_running_east_west_are_as_much_darker_as_vizdooms():
     # Doom gives walls running east-west 16 light levels less than walls running
     # north-south (WallHorizLight / WallVertLight). ViZDoom, facing the room's north
     # (east-west) wall from 1, 2, 4 m: 27, 20, 17 grey; the east (north-south) one: 38, 34, 30.
-    env = empty_room(palette.STONE_ROOM)
+    env = empty_room("stone")
     face = env.task.config.size * env.task.config.cell_size / 2  # the outer wall's face: the edge
     for distance, doom in ((1.0, 26.7), (2.0, 20.4), (4.0, 16.5)):
         grey = frame_at(env, 0.0, face - distance, np.pi / 2)[24:32, 50:62].mean()
@@ -88,7 +87,7 @@ def test_a_wall_seen_along_a_corridor_is_lit_by_its_depth_as_in_vizdoom():
     # drawn with the paper's Freedoom 0.10.1, whose STONE2 mjmaze's walls show: a band's
     # mean is its patch of the texture under Doom's light. The nearest band is left out:
     # ViZDoom draws it brighter than any depth of its head-on walls does.
-    env = empty_room(palette.STONE_ROOM)
+    env = empty_room("stone")
     face = env.task.config.size * env.task.config.cell_size / 2  # the outer wall's face: the edge
     along_north = frame_at(env, -2.0, face - 0.5, 0.0)[26:34]  # the east-west wall on the left
     along_east = frame_at(env, face - 0.5, -2.0, np.pi / 2)[26:34]  # the north-south wall on the right
@@ -112,7 +111,7 @@ def test_a_wall_stands_as_tall_in_the_frame_as_in_vizdooms(distance, doom_rows):
     # (a focal length of 144 px down against 120 across: Doom's pixels are 1.2x as tall
     # as wide; python tools/doom_frames.py --projection), 0.8 * 64 / d of mjmaze's 64.
     # Square pixels drew it 1.2x too short (the ids before Labyrinth-v3).
-    env = empty_room(palette.SLIME_ROOM)
+    env = empty_room("slime")
     centre = frame_at(env, env.task.config.size - distance, 0.0, 0.0)[:, 50:62]
     env.task.close()
     red, green, blue = (centre[..., k].astype(int) for k in range(3))
@@ -126,7 +125,7 @@ def test_a_wall_stands_as_tall_in_the_frame_as_in_vizdooms(distance, doom_rows):
 
 
 def test_the_ego_camera_sees_dooms_106_degrees_across():
-    env = empty_room(palette.STONE_ROOM)
+    env = empty_room("stone")
     assert np.degrees(env.task.horizontal_fov) == pytest.approx(2 * np.degrees(np.arctan(160 / 120)), abs=0.01)
     env.task.close()
 
@@ -144,8 +143,8 @@ def test_two_colour_walls_are_the_released_grey_stone2():
 
 
 @pytest.mark.parametrize("room, floor, ceiling", [
-    (palette.STONE_ROOM, (48, 35, 18), (34, 34, 34)),  # FLAT1_1 brown, MFLR8_1 grey
-    (palette.SLIME_ROOM, (18, 35, 10), (0, 0, 9)),  # NUKAGE1 green, CEIL4_1 dark blue
+    ("stone", (48, 35, 18), (34, 34, 34)),  # FLAT1_1 brown, MFLR8_1 grey
+    ("slime", (18, 35, 10), (0, 0, 9)),  # NUKAGE1 green, CEIL4_1 dark blue
 ])  # ViZDoom with the paper's Freedoom 0.10.1 (python tools/doom_frames.py --calibrate --freedoom paper)
 def test_floor_and_ceiling_have_vizdooms_colours(room, floor, ceiling):
     env = empty_room(room)
@@ -190,7 +189,7 @@ ITEMS_1M_AHEAD = {
 
 def stone_room_with(sprite):
     """The empty STONE2 room whose first item is ``sprite`` (a K-item kind), shown."""
-    env = empty_room(palette.STONE_ROOM, mjcf.sprite_thing("item_0", sprite))
+    env = empty_room("stone", mjcf.sprite_thing("item_0", sprite))
     env.physics.show_objects(env.physics.object_ids(["item_0"]), True)
     return env
 
@@ -362,7 +361,7 @@ def test_an_item_s_picture_shows_whole_above_the_floor():
 
 
 def test_two_colour_items_are_the_green_and_the_red_armour_alternately():
-    env = empty_room(palette.SLIME_ROOM)
+    env = empty_room("slime")
     physics = env.physics
     ids = physics.object_ids(["item_0", "item_1"])
     physics.show_objects(ids, True)
@@ -439,7 +438,7 @@ def test_things_fade_with_depth_as_dooms_columns_do():
 
 def object_ahead(name, rgba, distance=2.0):
     """Mean colour of object ``name`` in colour ``rgba``, ``distance`` m ahead in the empty slime room."""
-    env = empty_room(palette.SLIME_ROOM)
+    env = empty_room("slime")
     physics = env.physics
     ids = physics.object_ids([name])
     physics.set_object_rgba(ids[0], rgba)
@@ -452,9 +451,7 @@ def object_ahead(name, rgba, distance=2.0):
 
 def test_the_pistol_when_asked_for_hides_a_floor_item_right_ahead():
     # No scenario draws it (the released maps clear the inventory); a task can (ViZDoom's own maps show it).
-    env = mjmaze.load("labyrinth", task_kwargs={"size": 5, "random": 0})
-    env.task.rules.pistol = True
-    env.task.close()  # the renderer is made again, with the pistol
+    env = mjmaze.load("labyrinth", task_kwargs={"size": 5, "random": 0, "pistol": True})
     env.reset()
     physics = env.physics
     exit_ids = physics.object_ids([labyrinth.EXIT.name])

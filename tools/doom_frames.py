@@ -276,9 +276,9 @@ def exit_figure() -> None:
 
 def empty_arena(room: str, pistol: bool = True):
     """An empty 10 m arena (Two-colour at complexity 0) coloured as ``room``, its objects hidden."""
-    task = suite.make_task("two_colour", {"complexity": 0, "item_cap": 0, "flashes": False})
-    task.rules.room = {"stone": palette.STONE_ROOM, "slime": palette.SLIME_ROOM}[room]
-    task.rules.pistol = pistol  # as the ViZDoom probe beside it (released_game's weapon)
+    # The pistol as the ViZDoom probe beside it (released_game's weapon).
+    task = suite.make_task("two_colour", {"complexity": 0, "item_cap": 0, "flashes": False, "room": room,
+                                          "pistol": pistol})
     env = base.make_environment(task)
     env.reset()
     env.physics.show_objects(env.physics.object_ids([o.name for o in task.rules.objects]), False)

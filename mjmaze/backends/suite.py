@@ -17,6 +17,7 @@ from dm_control.rl import control
 
 from mjmaze import scenarios
 from mjmaze.backends import dm_task as base
+from mjmaze.build import palette
 from mjmaze.drawing import look
 from mjmaze.game import core, registry
 
@@ -26,6 +27,8 @@ VIEW_ARGUMENTS = tuple(field.name for field in dataclasses.fields(look.View))
 
 def register(scenario: registry.Scenario) -> registry.Scenario:
     """Registers a scenario: ``load``, ``gymnasium.make`` (and its vector env) and the tools then know it."""
+    if scenario.room not in palette.ROOMS:
+        raise ValueError(f"scenario {scenario.name!r}: room must be one of {tuple(palette.ROOMS)}, got {scenario.room!r}")
     registry.register(scenario)
     if scenario.gym_id not in gymnasium.registry:
         gymnasium.register(

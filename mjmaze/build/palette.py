@@ -37,11 +37,6 @@ class Room:
 #: floor (brown), ``MFLR8_1`` ceiling (grey), as the released generators write them.
 STONE_ROOM = Room(wall=(0.33, 0.33, 0.33), floor=(0.52, 0.40, 0.19), ceiling=(0.133, 0.133, 0.133))
 
-
-def room_of(rules) -> Room:
-    """A scenario's room: the one its rules name (``MazeRules.room``), or Doom's stone room."""
-    return rules.room or STONE_ROOM
-
 #: Two-colour: ``STONE2`` walls (grey), ``NUKAGE1`` floor (green slime), ``CEIL4_1`` ceiling.
 #: The walls are every scenario's ``STONE2``: the released generator writes each
 #: side with it and replaces the base map's ``GSTONE1`` (green-grey) walls, which
@@ -50,6 +45,9 @@ def room_of(rules) -> Room:
 #: until ``TwoColour-v10`` it was 0.13's, twice as bright (blue 17).
 SLIME_ROOM = Room(wall=STONE_ROOM.wall, floor=(0.20, 0.40, 0.13), ceiling=(0.0, 0.0, 0.035),
                   floor_texture="NUKAGE1", ceiling_texture="CEIL4_1")
+#: The rooms by the names a scenario's declaration (:attr:`mjmaze.game.registry.Scenario.room`) and the
+#: ``room`` view argument (:class:`mjmaze.drawing.look.View`) give.
+ROOMS = {"stone": STONE_ROOM, "slime": SLIME_ROOM}
 #: Doom's tall green and red columns (things 30, 32: Find-and-return's pillars,
 #: Two-colour's totem) as ViZDoom draws them, on a cylinder of their radius.
 TALL_GREEN_COLUMN_RGBA = (0.24, 0.51, 0.17, 1.0)

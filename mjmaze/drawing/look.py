@@ -28,7 +28,7 @@ class View:
     """How an env's frames look: their size and what Doom draws beyond the scene (the rules know none of it).
 
     A scenario's task arguments ``width``, ``height``, ``visual_style``,
-    ``head_bob`` and ``flashes`` make one (:func:`mjmaze.backends.suite.make_view`).
+    ``head_bob``, ``flashes``, ``pistol`` and ``room`` make one (:func:`mjmaze.backends.suite.make_view`).
     """
 
     #: The frames' size in pixels (16..1024 each).
@@ -40,6 +40,14 @@ class View:
     head_bob: bool = True
     #: Doom's full-screen flashes: red when hurt, gold on a pickup (:func:`flash_tint`).
     flashes: bool = True
+    #: Doom's pistol at the frame's bottom ("textured" style). The released .cfg files say
+    #: ``render_weapon = true``, but every released map's ENTER script calls ``ClearInventory()``:
+    #: ViZDoom drew no weapon in any of the paper's scenarios, so none is drawn by default (the ``-v0``
+    #: ids drew one; ViZDoom's own maps show it, as ``tools/doom_frames.py``'s probes do).
+    pistol: bool = False
+    #: Another room than the scenario's (:data:`mjmaze.build.palette.ROOMS`: ``"stone"``, ``"slime"``);
+    #: None: the scenario's own (:attr:`mjmaze.game.registry.Scenario.room`).
+    room: str | None = None
 
     def __post_init__(self):
         for name in ("width", "height"):
@@ -49,11 +57,13 @@ class View:
             object.__setattr__(self, name, int(value))
         if self.visual_style not in mjcf.VISUAL_STYLES:
             raise ValueError(f"visual_style must be one of {mjcf.VISUAL_STYLES}, got {self.visual_style!r}")
-        for name in ("head_bob", "flashes"):
+        for name in ("head_bob", "flashes", "pistol"):
             value = getattr(self, name)
             if not isinstance(value, (bool, np.bool_)):
                 raise ValueError(f"{name} must be True or False, got {value!r}")
             object.__setattr__(self, name, bool(value))
+        if self.room is not None and self.room not in palette.ROOMS:
+            raise ValueError(f"room must be None (the scenario's) or one of {tuple(palette.ROOMS)}, got {self.room!r}")
 
     @property
     def textured(self) -> bool:
@@ -412,8 +422,8 @@ class FramePipeline:
     """
 
     def __init__(self, xp, device, view: View, rules, model: mujoco.MjModel, ids):
-        """``rules``: the scenario's core (:class:`mjmaze.game.core.MazeRules`: its ``objects``, ``layout``,
-        whether it has a ``pistol``); ``model`` and ``ids``: the arena compiled
+        """``rules``: the scenario's core (:class:`mjmaze.game.core.MazeRules`: its ``objects`` and
+        ``layout``); ``model`` and ``ids``: the arena compiled
         (:class:`mjmaze.build.arena.ArenaIds`)."""
         self._xp, self._device = xp, device
         self._width, self._height = view.width, view.height
@@ -422,7 +432,7 @@ class FramePipeline:
         self.light = (DoomLight(xp, device, view.width, view.height, rules.layout.grid_size, rules.layout.cell_size)
                       if textured else None)
         # The pistol is drawn where the released runs drew it: in the paper's look.
-        self._head_bob, self._pistol, self._flashes = view.head_bob, rules.pistol and textured, view.flashes
+        self._head_bob, self._pistol, self._flashes = view.head_bob, view.pistol and textured, view.flashes
         self._tints: dict[tuple[int, int], tuple] = {}  # (damage, bonus) -> the flash's (rgb, alpha), on numpy
         if self.sprites is not None and len(self.sprites):
             self._sprite_objects = xp.asarray(self.sprites.object_index, device=device)

@@ -28,7 +28,7 @@ from mjmaze.game import configs, doom, arrays
 from mjmaze.game import layouts as layout_files
 
 if TYPE_CHECKING:
-    from mjmaze.build import mjcf, palette
+    from mjmaze.build import mjcf
 
 # Timing: one physics step is one Doom tic (mjmaze.game.doom); the agent acts every 4 tics.
 STEPS_PER_SECOND = doom.TICS_PER_SECOND / doom.TICS_PER_STEP  # real time: 8.75 observations a second
@@ -73,13 +73,6 @@ class MazeRules(abc.ABC):
     objects: Sequence[mjcf.ObjectGeom] = ()
     #: The scenario's name, as passed to ``mjmaze.load`` (it also enters the maze seeds).
     scenario: str = ""
-    #: The colours of its walls, floor and ceiling (the released Doom textures'); None: Doom's stone room
-    #: (:data:`mjmaze.build.palette.STONE_ROOM`), which the arena's build gives it.
-    room: palette.Room | None = None
-    #: Whether frames show Doom's pistol (in the "textured" style). The released .cfg files say
-    #: ``render_weapon = true``, but every released map's ENTER script calls ``ClearInventory()``:
-    #: ViZDoom drew no weapon in any of the paper's scenarios, so none does here (the ``-v0`` ids drew one).
-    pistol: bool = False
     #: Whether :meth:`start` costs much more than a step's rules for a batch: a batch backend then
     #: starts only the envs that need it, rather than every env under a mask (:mod:`mjmaze.backends.warp`).
     costly_start: bool = False

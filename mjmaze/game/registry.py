@@ -38,6 +38,10 @@ class Scenario:
       metric_scale: factor from that field's mean to the paper's units.
       metric_units: those units, for tables and plots (``"success %"``).
       cell_size: grid cell size in metres (for imported layouts).
+      room: the name of its room, the colours and textures of its walls, floor and ceiling
+        (:data:`mjmaze.build.palette.ROOMS`): Doom's ``"stone"`` room unless its released maps
+        had another (Two-colour's ``"slime"``). A part of its look, not of its rules; the ``room``
+        view argument shows another.
       item_codes: for layouts that list coloured items (``items`` of
         ``[x, y, code]``), the codes in collection order; ``None`` for layouts
         with ``start`` and ``end``.
@@ -59,6 +63,7 @@ class Scenario:
     cell_size: float
     item_codes: tuple[str, ...] | None = None
     imported_spawn_may_share_a_cell: bool = False
+    room: str = "stone"
     #: 0.1's name of ``rules``: accepted one more release (0.2), with a warning. An init-only
     #: argument, not a field (``dataclasses.replace`` reads the class's ``None``).
     task: dataclasses.InitVar[type | None] = None

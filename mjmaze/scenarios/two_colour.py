@@ -124,7 +124,6 @@ class TwoColour(core.MazeRules):
     """Pick up items of the totem's colour to stay alive; see the module docstring."""
 
     scenario = "two_colour"
-    room = palette.SLIME_ROOM
     objects = (TOTEM, *ITEMS)
     # 21 items, each tried at 32 points against every wall box: ~21x a step's spawn.
     costly_start = True
@@ -310,4 +309,6 @@ SCENARIO = registry.Scenario(
     # The released generator could spawn the agent in the totem's cell; such
     # an imported layout plays as released (see TwoColour).
     imported_spawn_may_share_a_cell=True,
+    # The released maps' NUKAGE1 floor and CEIL4_1 ceiling (mjmaze.build.palette.SLIME_ROOM).
+    room="slime",
 )
