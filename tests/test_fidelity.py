@@ -18,7 +18,7 @@ from conftest import FORWARD, place
 import mjmaze
 from mjmaze.build import mjcf, palette, sprites, walls
 from mjmaze.drawing import render
-from mjmaze.game import core, doom, layouts, registry
+from mjmaze.game import core, doom, layouts, registry, wall_boxes
 from mjmaze.scenarios import find_return, k_item, two_colour
 
 STEP = -0.0004
@@ -87,7 +87,7 @@ def test_texels_keep_their_size_on_walls_of_any_length():
     for box in range(2):
         quad = slice(box * 20, box * 20 + 4)  # the y- side: seen from -y, left to right along +x
         assert np.allclose(texcoords[quad, 0], verts[quad, 0] - (boxes[box, 0] - boxes[box, 2]))
-        assert np.allclose(texcoords[quad, 1], walls.WALL_HEIGHT - verts[quad, 2])
+        assert np.allclose(texcoords[quad, 1], wall_boxes.WALL_HEIGHT - verts[quad, 2])
         quad = slice(box * 20 + 8, box * 20 + 12)  # the y+ side: seen from +y, left to right along -x
         assert np.allclose(texcoords[quad, 0], (boxes[box, 0] + boxes[box, 2]) - verts[quad, 0])
 
@@ -103,7 +103,7 @@ def test_wall_textures_start_again_at_each_grid_line_as_the_released_blocks_do()
     boxes, keep, spans = walls.wall_pieces(h_walls, v_walls, 1.25)
     verts, _, _, _, texcoords = walls._box_mesh(boxes, keep, spans)
     quads, coords = verts.reshape(-1, 4, 3), texcoords.reshape(-1, 4, 2)
-    half = walls.WALL_THICKNESS / 2
+    half = wall_boxes.WALL_THICKNESS / 2
     inner = np.isclose(quads[:, :, 1], (2 - 0.5 - 2) * 1.25 - half).all(axis=1)  # the run's south face
     assert inner.sum() >= 3
     grid_lines = (np.arange(1, 5) - 0.5 - 2) * 1.25
@@ -282,7 +282,7 @@ def test_the_agent_blocks_as_a_square_at_a_wall_end():
     # stop it square-on at its radius, where a round agent would roll round the corner.
     env = load("labyrinth", size=7)
     x, y = free_wall_end(env)
-    lane = y + walls.WALL_THICKNESS / 2 + core.AGENT_RADIUS - 0.02
+    lane = y + wall_boxes.WALL_THICKNESS / 2 + core.AGENT_RADIUS - 0.02
     place(env, x + 0.6, lane, math.pi)
     path = push(env, FORWARD, 20)
     assert path[-1, 0] == pytest.approx(x + core.AGENT_RADIUS, abs=TOLERANCE)
@@ -332,7 +332,7 @@ def test_an_item_is_within_reach_in_doom_s_square(offset, reached):
 
 def clearance_from_walls(config, xy):
     """How far a square centred at each point can grow before it meets a wall (Doom tests things by squares)."""
-    boxes = walls.wall_runs(config.h_walls, config.v_walls, config.cell_size)
+    boxes = wall_boxes.wall_runs(config.h_walls, config.v_walls, config.cell_size)
     gap_x = np.abs(xy[:, None, 0] - boxes[:, 0]) - boxes[:, 2]
     gap_y = np.abs(xy[:, None, 1] - boxes[:, 1]) - boxes[:, 3]
     return np.maximum(gap_x, gap_y).min(axis=1)

@@ -6,7 +6,6 @@ Run on Warp's CPU device (no GPU needed): a first run compiles Warp's kernels
 
 from __future__ import annotations
 
-import contextlib
 import json
 import os
 

@@ -44,9 +44,9 @@ import numpy as np
 import mjmaze
 from mjmaze.backends import dm_task as base
 from mjmaze.backends import suite, vizdoom_env
-from mjmaze.build import mjcf, palette, sprites, walls
+from mjmaze.build import mjcf, sprites
 from mjmaze.drawing import look
-from mjmaze.game import configs, maze
+from mjmaze.game import configs, maze, wall_boxes
 
 #: The game data ViZDoom draws with (``--freedoom``): None, the installed ViZDoom's own.
 from mjmaze.scenarios import find_return, k_item, two_colour
@@ -421,7 +421,7 @@ def light() -> None:
     print("floor (red) and ceiling by row, depth (m): Doom | mjmaze")
     for row in (*range(0, 14, 2), *range(36, height, 3)):
         tangent = (height / 2 - row - 0.5) / (mjcf.DOOM_FOCAL_DOWN * height)  # up, of the row's ray
-        depth = (walls.WALL_HEIGHT - mjcf.EYE_HEIGHT) / tangent if tangent > 0 else -mjcf.EYE_HEIGHT / tangent
+        depth = (wall_boxes.WALL_HEIGHT - mjcf.EYE_HEIGHT) / tangent if tangent > 0 else -mjcf.EYE_HEIGHT / tangent
         channel = 0 if tangent < 0 else slice(None)
         print(f"  row {row:2d} ({'ceiling' if tangent > 0 else 'floor'}, {depth:5.2f} m): "
               f"{doom[row, 40:72][..., channel].mean():5.1f} | {ours[row, 40:72][..., channel].mean():5.1f}")

@@ -47,10 +47,10 @@ import warp as wp
 from gymnasium.vector import AutoresetMode
 
 from mjmaze.backends import batch, physics, suite
-from mjmaze.build import mjcf, walls
+from mjmaze.build import mjcf
 from mjmaze.build.arena import Arena, ArenaIds
 from mjmaze.drawing import look
-from mjmaze.game import core, doom, arrays
+from mjmaze.game import arrays, core, doom, wall_boxes
 
 # Where a geom that must not be seen or touched in a world goes (below the floor).
 _AWAY_Z = -50.0
@@ -79,9 +79,9 @@ def build_model(rules: core.MazeRules, view: look.View) -> tuple[mujoco.MjModel,
         first_of_layout.setdefault(layout, config)
     model, ids = Arena(rules, view, layouts=list(first_of_layout.values())).compile()
     mesh_of_config = ids.wall_meshes[layout_of_config].astype(np.int32)
-    # Boxes follow h_walls then v_walls (walls.wall_segments).
+    # Boxes follow h_walls then v_walls (wall_boxes.wall_segments).
     present = np.array([np.concatenate([c.h_walls.ravel(), c.v_walls.ravel()]) for c in all_configs], dtype=bool)
-    box_z = np.where(present, walls.WALL_HEIGHT / 2, _AWAY_Z).astype(np.float32)
+    box_z = np.where(present, wall_boxes.WALL_HEIGHT / 2, _AWAY_Z).astype(np.float32)
     return model, ids, mesh_of_config, box_z
 
 

@@ -21,7 +21,7 @@ import mujoco
 import numpy as np
 
 from mjmaze.build import mjcf, palette, walls
-from mjmaze.game import configs, registry
+from mjmaze.game import configs, registry, wall_boxes
 
 
 @dataclasses.dataclass(frozen=True)
@@ -31,7 +31,7 @@ class ArenaIds:
     Every model compiled from one :class:`Arena` has the same ids.
     """
 
-    #: ``(segments,)``: the walls' collision boxes, in :func:`mjmaze.build.walls.wall_segments` order.
+    #: ``(segments,)``: the walls' collision boxes, in :func:`mjmaze.game.wall_boxes.wall_segments` order.
     wall_boxes: np.ndarray
     #: The geom that draws the walls' mesh.
     wall_visual: int
@@ -70,7 +70,7 @@ class Arena:
         #: The arena's MJCF (compile it, then :meth:`finish` the model).
         self.xml = mjcf.build_xml(rules.layout.grid_size, self.cell_size, self.objects, view.visual_style, self.room,
                                   wall_layout_quads=quads, width=view.width)
-        self._num_segments = len(walls.wall_segments(rules.layout.grid_size, self.cell_size))
+        self._num_segments = len(wall_boxes.wall_segments(rules.layout.grid_size, self.cell_size))
 
     def compile(self) -> tuple[mujoco.MjModel, ArenaIds]:
         """A model of the arena, final, and its ids."""

@@ -20,6 +20,7 @@ import mujoco
 import numpy as np
 
 from mjmaze.build import palette, sprites, walls
+from mjmaze.game import wall_boxes
 
 #: ``visual_style`` values: "textured" (the default) gives walls and floor
 from mjmaze.game import doom
@@ -119,7 +120,7 @@ def template_path(name: str = "arena.xml"):
 
 def overhead_extent(grid_size: int, cell_size: float) -> float:
     """Side in metres of the square the overhead camera sees: the arena and a small border."""
-    return grid_size * cell_size + 2 * walls.WALL_THICKNESS + 0.25
+    return grid_size * cell_size + 2 * wall_boxes.WALL_THICKNESS + 0.25
 
 
 def build_xml(
@@ -152,7 +153,7 @@ def build_xml(
                   emission=f"{CEILING_GLOW - palette.AMBIENT}", specular="0", shininess="0", reflectance="0")
     if visual_style == "textured":
         _add_textures(root, room)
-    segments = walls.wall_segments(grid_size, cell_size)
+    segments = wall_boxes.wall_segments(grid_size, cell_size)
 
     if batch:
         arena = ET.SubElement(worldbody, "body", name=ARENA_BODY, mocap="true", pos="0 0 0")
@@ -168,7 +169,7 @@ def build_xml(
         ET.SubElement(worldbody, "geom", name=walls.WALL_VISUAL, type="mesh", mesh=walls.WALL_MESH, material="wall")
     # The floor after the walls: MuJoCo draws geoms in model order, so floor
     # pixels hidden by walls fail the depth test before any shading.
-    half_extent = grid_size * cell_size / 2 + walls.WALL_THICKNESS
+    half_extent = grid_size * cell_size / 2 + wall_boxes.WALL_THICKNESS
     # Plane grid spacing LIT_QUAD: finer grids cost llvmpipe more per frame.
     ET.SubElement(
         worldbody, "geom", name="floor", type="plane", material="floor",
@@ -180,7 +181,7 @@ def build_xml(
     # (a box's underside at different offsets), as on the floor.
     ET.SubElement(
         worldbody, "geom", name="ceiling", type="plane", material="ceiling", group=str(CEILING_GROUP),
-        size=f"{half_extent} {half_extent} {2 * half_extent}", pos=f"0 0 {walls.WALL_HEIGHT}", quat="0 1 0 0",
+        size=f"{half_extent} {half_extent} {2 * half_extent}", pos=f"0 0 {wall_boxes.WALL_HEIGHT}", quat="0 1 0 0",
     )
     # An orthographic camera looking straight down at the whole arena, image up
     # = +y, for top-down maps (mjmaze.viz); fovy is then the view's height in metres.
@@ -193,7 +194,7 @@ def build_xml(
             arena, "geom", name=walls.WALL_BOX_NAME.format(k), **{"class": "wall_collision"},
             # Compiled in place: MuJoCo's midphase keeps the world body's
             # geom bounding boxes from compile time, so boxes never move.
-            size=f"{hx} {hy} {walls.WALL_HEIGHT / 2}", pos=f"{x} {y} {walls.WALL_HEIGHT / 2}",
+            size=f"{hx} {hy} {wall_boxes.WALL_HEIGHT / 2}", pos=f"{x} {y} {wall_boxes.WALL_HEIGHT / 2}",
         )
     colliding = []  # batch: (object, attributes) of the colliding objects, placed after the others
     for obj in objects:  # see ObjectGeom

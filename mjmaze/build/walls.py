@@ -1,4 +1,7 @@
-"""The arena's walls: collision boxes for every possible segment, and a visual mesh per maze.
+"""The arena's walls in MuJoCo: collision boxes for every possible segment, and a visual mesh per maze.
+
+Where the boxes stand is :mod:`mjmaze.game.wall_boxes`' (the rules read it without MuJoCo);
+this module writes them into a model.
 
 One model is compiled per (scenario, grid size): it holds a *pool* of wall
 collision boxes, one per possible wall segment of the grid, and one visual mesh
@@ -19,14 +22,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-if TYPE_CHECKING:  # the walls are arrays: a scenario's rules read their boxes without MuJoCo
+from mjmaze.game import wall_boxes
+
+if TYPE_CHECKING:
     import mujoco
 
-WALL_THICKNESS = 0.125
-WALL_HEIGHT = 1.0
 WALL_MESH = "walls"
 WALL_VISUAL = "walls_visual"  # the geom drawing the walls' mesh
-WALL_BOX_NAME = "wall_{}"  # the collision boxes wall_0, wall_1, ... in wall_segments order
+WALL_BOX_NAME = "wall_{}"  # the collision boxes wall_0, wall_1, ... in mjmaze.game.wall_boxes.wall_segments order
 
 # Per wall box in the visual mesh: 4 side faces + the top (the bottom is never
 # seen), each a quad of its own 4 vertices (texture coordinates differ per
@@ -36,45 +39,9 @@ _BOX_VERTS, _BOX_FACES, _BOX_NORMALS = 4 * _BOX_QUADS, 2 * _BOX_QUADS, _BOX_QUAD
 _SIDE_CORNERS = ((0, 1), (1, 2), (2, 3), (3, 0))
 
 
-def wall_segments(grid_size: int, cell_size: float) -> np.ndarray:
-    """Every possible wall segment of the grid as rows ``(x, y, half_x, half_y)``.
-
-    Horizontal segments come first, in ``h_walls`` order, then vertical ones in
-    ``v_walls`` order (see :mod:`mjmaze.game.maze`). As the released mazes build
-    them: an inner wall is a box one cell long, ends flush with the grid lines,
-    centred on its line; the outer walls stand outside the grid's edge.
-    """
-    n = grid_size
-    rows = []
-    for i in range(n + 1):
-        for j in range(n):
-            rows.append(_box(True, i, j, j + 1, n, cell_size))
-    for i in range(n):
-        for j in range(n + 1):
-            rows.append(_box(False, j, i, i + 1, n, cell_size))
-    return np.array(rows, dtype=np.float64)
-
-
-def _box(horizontal: bool, line: int, start: int, stop: int, n: int, cell_size: float) -> tuple:
-    """The box ``(x, y, half_x, half_y)`` of cells ``start..stop-1`` of wall on grid line ``line``.
-
-    The released generator (``generate_*.py``) pads each inner wall 8 map
-    units either side of its line and not past its ends; the maze's edge is
-    the sector's own boundary, with nothing inside it: so an inner wall's end
-    is its grid line, and the outer wall's face is the edge itself (its box
-    lies outside, long enough to close the corners).
-    """
-    half, thick = (n - 1) / 2, WALL_THICKNESS / 2
-    outer = line in (0, n)
-    across = (line - 0.5 - half) * cell_size + (thick if line == n else -thick if line == 0 else 0.0)
-    a, b = (start - 0.5 - half) * cell_size, (stop - 0.5 - half) * cell_size
-    along, along_half = (a + b) / 2, (b - a) / 2 + (2 * thick if outer else 0.0)
-    return (along, across, along_half, thick) if horizontal else (across, along, thick, along_half)
-
-
 def placeholder_quads(grid_size: int, cell_size: float) -> int:
     """The most quads any maze of the grid needs in the visual mesh (every segment cut into pieces, five quads each)."""
-    return len(wall_segments(grid_size, cell_size)) * _pieces_per_segment(cell_size) * _BOX_QUADS
+    return len(wall_boxes.wall_segments(grid_size, cell_size)) * _pieces_per_segment(cell_size) * _BOX_QUADS
 
 
 def add_placeholder_mesh(asset: ET.Element, name: str, quads: int) -> None:
@@ -132,7 +99,7 @@ def wall_mesh_quads(h_walls: np.ndarray, v_walls: np.ndarray, cell_size: float) 
 
 def _box_mesh(boxes: np.ndarray, keep: np.ndarray | None = None, spans: np.ndarray | None = None):
     """Vertices, faces, normals, face-normal indices and texture coordinates of
-    boxes ``(x, y, hx, hy)`` standing on the floor, ``WALL_HEIGHT`` tall, as one mesh.
+    boxes ``(x, y, hx, hy)`` standing on the floor, ``wall_boxes.WALL_HEIGHT`` tall, as one mesh.
 
     ``keep`` ``(boxes, 5)`` says which quads to draw (sides y-, x+, y+, x-, then
     the top); default all.
@@ -154,14 +121,14 @@ def _box_mesh(boxes: np.ndarray, keep: np.ndarray | None = None, spans: np.ndarr
     verts = np.zeros((k, _BOX_QUADS, 4, 3))
     texcoords = np.zeros((k, _BOX_QUADS, 4, 2))
     for side, (a, b) in enumerate(_SIDE_CORNERS):  # quad: a bottom, b bottom, b top, a top
-        for corner, (c, z) in enumerate(((a, 0.0), (b, 0.0), (b, WALL_HEIGHT), (a, WALL_HEIGHT))):
+        for corner, (c, z) in enumerate(((a, 0.0), (b, 0.0), (b, wall_boxes.WALL_HEIGHT), (a, wall_boxes.WALL_HEIGHT))):
             verts[:, side, corner] = np.stack([corner_x[:, c], corner_y[:, c], np.full(k, z)], axis=1)
             # Seen from outside, side y- runs left to right along +x, x+ along +y, y+ along -x, x- along -y.
             along = (corner_x[:, c] - spans[:, 0], corner_y[:, c] - spans[:, 2],
                      spans[:, 1] - corner_x[:, c], spans[:, 3] - corner_y[:, c])[side]
-            texcoords[:, side, corner] = np.stack([along, np.full(k, WALL_HEIGHT - z)], axis=1)
+            texcoords[:, side, corner] = np.stack([along, np.full(k, wall_boxes.WALL_HEIGHT - z)], axis=1)
     for corner in range(4):  # the top
-        verts[:, 4, corner] = np.stack([corner_x[:, corner], corner_y[:, corner], np.full(k, WALL_HEIGHT)], axis=1)
+        verts[:, 4, corner] = np.stack([corner_x[:, corner], corner_y[:, corner], np.full(k, wall_boxes.WALL_HEIGHT)], axis=1)
         texcoords[:, 4, corner] = np.stack([corner_x[:, corner], corner_y[:, corner]], axis=1)
     side_normals = np.array([(0, -1, 0), (1, 0, 0), (0, 1, 0), (-1, 0, 0), (0, 0, 1)], dtype=np.float64)
     normals = np.broadcast_to(side_normals, (k, _BOX_NORMALS, 3))
@@ -195,7 +162,7 @@ def _wall_mesh(h_walls: bytes, h_shape: tuple, v_walls: bytes, v_shape: tuple, c
 class WallLayout:
     """Writes a configuration's walls into a compiled CPU arena model (:class:`mjmaze.build.arena.Arena`).
 
-    ``box_ids``: the wall boxes, in :func:`wall_segments` order; ``mesh_id``: the
+    ``box_ids``: the wall boxes, in :func:`mjmaze.game.wall_boxes.wall_segments` order; ``mesh_id``: the
     walls' mesh (an :class:`mjmaze.build.arena.ArenaIds`'s ``wall_boxes`` and ``wall_meshes[0]``).
     After :meth:`apply`, re-upload mesh :attr:`mesh_id` to every rendering
     context of the model.
@@ -221,18 +188,6 @@ class WallLayout:
         write_wall_mesh(model, self.mesh_id, h_walls, v_walls, self._cell_size)
 
 
-def wall_runs(h_walls: np.ndarray, v_walls: np.ndarray, cell_size: float) -> np.ndarray:
-    """Straight runs of adjacent walls as boxes ``(x, y, half_x, half_y)`` (placed as :func:`_box` places them)."""
-    n = h_walls.shape[1]
-    boxes = []
-    for line in range(n + 1):
-        for start, stop in _runs(h_walls[line]):  # columns start..stop-1 on horizontal line `line`
-            boxes.append(_box(True, line, start, stop, n, cell_size))
-        for start, stop in _runs(v_walls[:, line]):  # rows start..stop-1 on vertical line `line`
-            boxes.append(_box(False, line, start, stop, n, cell_size))
-    return np.array(boxes, dtype=np.float64).reshape(-1, 4)
-
-
 # Longest piece of wall in the visual mesh: the light's fall-off is computed at
 # vertices (fixed-function GL) and interpolated, so a long run is cut into
 # pieces to keep its far end darker than its near end.
@@ -241,12 +196,12 @@ MAX_PIECE_LENGTH = 1.0
 
 def _pieces_per_segment(cell_size: float) -> int:
     """Upper bound on mesh pieces per wall segment (a run of L segments has at most L times this)."""
-    return math.ceil((cell_size + 2 * WALL_THICKNESS) / MAX_PIECE_LENGTH)
+    return math.ceil((cell_size + 2 * wall_boxes.WALL_THICKNESS) / MAX_PIECE_LENGTH)
 
 
 def wall_pieces(h_walls: np.ndarray, v_walls: np.ndarray,
                 cell_size: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The visual walls: runs of walls (:func:`wall_runs`) cut at the grid lines and into pieces of at
+    """The visual walls: runs of walls (:func:`mjmaze.game.wall_boxes.wall_runs`) cut at the grid lines and into pieces of at
     most :data:`MAX_PIECE_LENGTH`.
 
     Returns boxes ``(x, y, hx, hy)``, which of each box's quads to draw
@@ -263,8 +218,8 @@ def wall_pieces(h_walls: np.ndarray, v_walls: np.ndarray,
     for horizontal, lines in ((True, h_walls), (False, v_walls.T)):
         for line, flags in enumerate(lines):
             outer = line in (0, n)
-            for start, stop in _runs(flags):
-                x, y, hx, hy = _box(horizontal, line, start, stop, n, cell_size)
+            for start, stop in wall_boxes.runs(flags):
+                x, y, hx, hy = wall_boxes.segment_box(horizontal, line, start, stop, n, cell_size)
                 (middle, length), (across, thick) = ((x, hx), (y, hy)) if horizontal else ((y, hy), (x, hx))
                 grid_lines = [(k - 0.5 - half) * cell_size for k in range(start + 1, stop)]
                 cuts = [middle - length, *grid_lines, middle + length]
@@ -286,9 +241,3 @@ def wall_pieces(h_walls: np.ndarray, v_walls: np.ndarray,
                             spans.append((across - thick, across + thick, line_low, line_high))
     return (np.array(boxes, dtype=np.float64).reshape(-1, 4), np.array(keep, dtype=bool).reshape(-1, _BOX_QUADS),
             np.array(spans, dtype=np.float64).reshape(-1, 4))
-
-
-def _runs(flags: np.ndarray) -> list[tuple[int, int]]:
-    """``[(start, stop)]`` of the runs of True in a 1-D boolean array."""
-    edges = np.diff(np.concatenate([[0], flags.astype(np.int8), [0]]))
-    return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)))

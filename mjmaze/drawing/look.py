@@ -16,9 +16,9 @@ from collections.abc import Sequence
 import mujoco
 import numpy as np
 
-from mjmaze.build import mjcf, palette, sprites, walls
+from mjmaze.build import mjcf, palette, sprites
 from mjmaze.drawing import compiled_light
-from mjmaze.game import doom, arrays
+from mjmaze.game import arrays, doom, wall_boxes
 
 DEFAULT_WIDTH, DEFAULT_HEIGHT = 112, 64
 
@@ -297,7 +297,7 @@ class DoomLight:
                                       device=device)  # (H, 1)
         self._thing_start = THING * _LIGHT_BINS
         self._cell, self._half_grid = float(cell_size), grid_size / 2
-        self._face = walls.WALL_THICKNESS / 2 / self._cell  # a wall face's offset from its grid line, in cells
+        self._face = wall_boxes.WALL_THICKNESS / 2 / self._cell  # a wall face's offset from its grid line, in cells
         self._on_face = _ON_PLANE / self._cell
         # An array, not a Python number: xp.minimum with a scalar would make torch build a tensor per call.
         self._white = xp.asarray(254.5, dtype=xp.float32, device=device)
@@ -313,7 +313,7 @@ class DoomLight:
         f32 = np.float32
         return (self._right, self._up, below, np.ascontiguousarray(self._gains),
                 np.ascontiguousarray(self._flat_start[:, 0]), f32(self._cell), f32(self._half_grid), f32(self._face),
-                f32(self._on_face), f32(_ON_PLANE), f32(walls.WALL_HEIGHT - _ON_PLANE), f32(_LIGHT_BINS * _NEAREST),
+                f32(self._on_face), f32(_ON_PLANE), f32(wall_boxes.WALL_HEIGHT - _ON_PLANE), f32(_LIGHT_BINS * _NEAREST),
                 f32(_LIGHT_BINS - 1), (NORTH_SOUTH_WALL * _LIGHT_BINS, EAST_WEST_WALL * _LIGHT_BINS),
                 self._thing_start)
 
@@ -349,7 +349,7 @@ class DoomLight:
             compiled_light.light(frames, inverse_depth, eye, cos, sin, self._compiled, lit)
             return lit
         # The floor and the ceiling: pixels at least as deep as their row's ray meets the plane.
-        height_above = xp.where(self._below, eye[:, 2:3] - _ON_PLANE, walls.WALL_HEIGHT - _ON_PLANE - eye[:, 2:3])
+        height_above = xp.where(self._below, eye[:, 2:3] - _ON_PLANE, wall_boxes.WALL_HEIGHT - _ON_PLANE - eye[:, 2:3])
         flat = inverse_depth < (self._up / height_above)[:, :, None]  # (B, H, W)
         # A column's wall is the deepest pixel in it (all else stands before it): its surface is the column's.
         wall_depth = 1 / xp.min(inverse_depth, axis=1)  # (B, W)

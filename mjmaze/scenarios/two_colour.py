@@ -44,8 +44,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from mjmaze.build import mjcf, palette, sprites, walls
-from mjmaze.game import configs, core, doom, registry, arrays, versions
+from mjmaze.build import mjcf, palette, sprites
+from mjmaze.game import arrays, configs, core, doom, registry, versions, wall_boxes
 
 if __doc__:  # python -OO drops docstrings
     __doc__ += versions.version_history(versions.TWO_COLOUR)
@@ -150,7 +150,7 @@ class TwoColour(core.MazeRules):
         # Each maze's wall boxes (x, y, half x, half y), padded with boxes far
         # away to one fixed count (every segment a run of its own at most), so
         # that any set of configurations stacks.
-        runs = [walls.wall_runs(config.h_walls, config.v_walls, config.cell_size) for config in configs_]
+        runs = [wall_boxes.wall_runs(config.h_walls, config.v_walls, config.cell_size) for config in configs_]
         padded = np.tile(np.array([_FAR_AWAY, _FAR_AWAY, 0.0, 0.0]), (len(configs_), 2 * GRID_SIZE * (GRID_SIZE + 1), 1))
         for row, boxes in zip(padded, runs):
             row[: len(boxes)] = boxes
