@@ -346,6 +346,31 @@ def test_bad_arguments_say_what_to_do():
         mjwarp.MazeBatchEnv(2, "labyrinth", device="cpu", render=False, size=5).step([0, 0])
 
 
+@pytest.mark.parametrize("facts, problem", [
+    (("cpu", False, True, True), "needs a CUDA device"),
+    (("cuda", False, False, True), "conditional nodes"),
+    (("cuda", False, True, False), "memory pool"),
+    (("cuda", True, True, True), "restart_by_index"),
+    (("cuda", False, True, True), None),
+])
+def test_what_a_cuda_graph_needs_of_the_device_is_checked_from_its_facts(facts, problem):
+    found = mjwarp.cuda_graph_problem(*facts)
+    assert found is None if problem is None else problem in found
+
+
+def test_a_cuda_device_reaches_the_cuda_graph_checks_in_the_constructor(monkeypatch):
+    # The constructor as on a GPU (torch and Warp told a CUDA device is there), up to the checks: a
+    # device without conditional graphs is one clear error, not an attribute read before it is set.
+    import types
+
+    monkeypatch.setattr(torch.cuda, "is_available", lambda: True)
+    monkeypatch.setattr(mjwarp.wp, "get_device", lambda name=None: types.SimpleNamespace(is_cuda=True))
+    monkeypatch.setattr(mjwarp.wp, "is_conditional_graph_supported", lambda: True)
+    monkeypatch.setattr(mjwarp.wp, "is_mempool_enabled", lambda device: False)
+    with pytest.raises(ValueError, match="memory pool"):
+        mjwarp.MazeBatchEnv(2, "labyrinth", device="cuda", cuda_graph=True, size=5)
+
+
 # Random episodes from each side, the same seeds and actions: Warp's float32
 # may make a long wall-sliding run drift, so the outcomes are compared as
 # statistics (a 4-sigma two-sample test on the metric and the episode length).

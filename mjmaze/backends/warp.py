@@ -85,6 +85,34 @@ def build_model(rules: core.MazeRules, view: look.View) -> tuple[mujoco.MjModel,
     return model, ids, mesh_of_config, box_z
 
 
+def cuda_graph_problem(device_type: str, restart_by_index: bool, conditional_graphs: bool, mempool: bool) -> str | None:
+    """Why ``cuda_graph=True`` cannot run on a device with these facts (None: it can).
+
+    ``conditional_graphs``: the driver and toolkit capture conditional nodes (MuJoCo Warp's solver
+    loop); ``mempool``: Warp's memory pool is on for the device (MuJoCo Warp allocates inside a step).
+    A pure function of the facts, so the checks a GPU runs are tested on any machine.
+    """
+    if device_type != "cuda":
+        return f"cuda_graph=True needs a CUDA device; got a {device_type!r} device"
+    if not conditional_graphs:
+        return ("cuda_graph=True needs CUDA graphs with conditional nodes (MuJoCo Warp's solver loop): "
+                "a CUDA 12.4+ driver and toolkit; pass cuda_graph=False")
+    if not mempool:
+        return ("cuda_graph=True needs Warp's memory pool on the device (MuJoCo Warp allocates inside "
+                "a step): leave wp.set_mempool_enabled alone, or pass cuda_graph=False")
+    if restart_by_index:
+        return ("cuda_graph=True cannot replay restart_by_index=True (it reads the restarting worlds' "
+                "count back from the device); leave restart_by_index at its default")
+    return None
+
+
+def _graph_facts(device: wp.Device) -> tuple[bool, bool]:
+    """``(conditional_graphs, mempool)`` of a Warp device, as :func:`cuda_graph_problem` takes them."""
+    if not device.is_cuda:
+        return False, False
+    return bool(wp.is_conditional_graph_supported()), bool(wp.is_mempool_enabled(device))
+
+
 class MazeBatchEnv(batch.BatchEnv):
     """``num_envs`` envs of a scenario in one MuJoCo Warp model on ``device``; see the module docstring.
 
@@ -149,50 +177,50 @@ class MazeBatchEnv(batch.BatchEnv):
         rules = suite.make_rules(scenario, task_kwargs)
         self.view = view = suite.make_view(scenario, task_kwargs)
         self._setup(num_envs, scenario, rules, view, autoreset_mode, render_modes=[])
-        n = self.num_envs
         self.device = torch.device(device)
+        self._wp_device = wp.get_device(str(device))
         if restart_by_index is None:
             restart_by_index = rules.costly_start and self.device.type == "cpu"
         self.restart_by_index = bool(restart_by_index)
-        if cuda_graph and self.device.type != "cuda":
-            raise ValueError(f"cuda_graph=True needs a CUDA device; got device={str(device)!r}")
-        if cuda_graph and not wp.is_conditional_graph_supported():
-            raise ValueError("cuda_graph=True needs CUDA graphs with conditional nodes (MuJoCo Warp's solver loop): "
-                             "a CUDA 12.4+ driver and toolkit; pass cuda_graph=False")
-        if cuda_graph and not wp.is_mempool_enabled(self._wp_device):
-            raise ValueError("cuda_graph=True needs Warp's memory pool on the device (MuJoCo Warp allocates inside "
-                             "a step): leave wp.set_mempool_enabled alone, or pass cuda_graph=False")
-        if cuda_graph and self.restart_by_index:
-            raise ValueError("cuda_graph=True cannot replay restart_by_index=True (it reads the restarting worlds' "
-                             "count back from the device); leave restart_by_index at its default")
-        self._wp_device = wp.get_device(str(device))
+        if cuda_graph:
+            problem = cuda_graph_problem(self.device.type, self.restart_by_index, *_graph_facts(self._wp_device))
+            if problem:
+                raise ValueError(problem)
         self.xp = arrays.namespace(torch.zeros(1))
-        height, width = view.height, view.width
-
         mjm, ids, mesh_of_config, box_z = build_model(rules, view)
         self._host_model = mjm
-        dev = self.device
+        self._hold_arena(rules, ids, mesh_of_config, box_z, first)
+        # What Doom draws beyond the scene, for every world at once: the CPU envs' pipeline.
+        self._pipeline = look.FramePipeline(self.xp, self.device, view, rules, mjm, ids)
+        self._timestep = float(mjm.opt.timestep)
+        self._actions = torch.tensor(rules.actions, dtype=torch.float64, device=self.device)  # (A, 2): forward, turn
+        self._put_on_device(mjm, ids, render_segmentation)
+        self._rendering = bool(render)
+        self._prepare_graphs(cuda_graph)
+        self._allocate_state()
+
+    def _hold_arena(self, rules: core.MazeRules, ids: ArenaIds, mesh_of_config, box_z, first: int) -> None:
+        """The configurations' table and the arena's ids on the device: what a restart and a step index."""
+        dev, n = self.device, self.num_envs
         table = rules.config_arrays([rules.configs[i] for i in range(len(rules.configs))])
         self._config_table = {name: torch.as_tensor(value, device=dev) for name, value in table.items()}
         self._mesh_of_config = torch.as_tensor(mesh_of_config, device=dev)
         self._box_z = torch.as_tensor(box_z, device=dev)
-        num_configs = len(rules.configs)
-        self._first = torch.tensor(batch.first_configs(first, n, num_configs), device=dev)
-
+        self._first = torch.tensor(batch.first_configs(first, n, len(rules.configs)), device=dev)
         self._box_ids = torch.as_tensor(ids.wall_boxes, device=dev)
         self._wall_visual = ids.wall_visual
         self._object_ids = torch.as_tensor(ids.objects, dtype=torch.long, device=dev)
         self._object_z = torch.tensor([obj.z for obj in rules.objects], dtype=torch.float32, device=dev)
-        # What Doom draws beyond the scene, for every world at once: the CPU envs' pipeline.
-        self._pipeline = look.FramePipeline(self.xp, dev, view, rules, mjm, ids)
         self._sprite_ids = torch.as_tensor(ids.sprites, dtype=torch.long, device=dev)
         colliding = np.flatnonzero(ids.collision >= 0)
         self._colliding = torch.as_tensor(colliding, dtype=torch.long, device=dev)
         self._collision_ids = torch.as_tensor(ids.collision[colliding], dtype=torch.long, device=dev)
-        self._timestep = float(mjm.opt.timestep)
-        self._actions = torch.tensor(rules.actions, dtype=torch.float64, device=dev)  # (A, 2): forward, turn
+        self._camera = ids.ego_camera
 
-        textured = view.textured
+    def _put_on_device(self, mjm: mujoco.MjModel, ids: ArenaIds, render_segmentation: bool) -> None:
+        """MuJoCo Warp's model (per-world fields batched), data and render context, and torch views of them."""
+        n, view = self.num_envs, self.view
+        height, width, textured = view.height, view.width, view.textured
         with wp.ScopedDevice(self._wp_device):
             batched = ({"geom_pos": n, "geom_rgba": n, "geom_dataid": n} | ({"cam_pos": n} if view.head_bob else {})
                        | ({"geom_quat": n, "geom_matid": n} if len(self._sprite_ids) else {}))
@@ -204,7 +232,6 @@ class MazeBatchEnv(batch.BatchEnv):
                 enabled_geom_groups=[0, 1, 2],
             )
         self._segmentation = render_segmentation
-        self._rendering = bool(render)
         # Torch views of the Warp arrays (no copies): what the env writes and reads.
         self._qpos = wp.to_torch(self._data.qpos)
         self._qvel = wp.to_torch(self._data.qvel)
@@ -215,22 +242,27 @@ class MazeBatchEnv(batch.BatchEnv):
         self._geom_matid = wp.to_torch(self._model.geom_matid)  # per world with sprites
         self._geom_dataid = wp.to_torch(self._model.geom_dataid)
         self._cam_pos = wp.to_torch(self._model.cam_pos)  # per world with head-bob
-        self._camera = ids.ego_camera
         self._rgb_packed = wp.to_torch(self._render.rgb_data)
         self._depth = wp.to_torch(self._render.depth_data).view(n, height, width) if textured else None
         self._cam_xpos = wp.to_torch(self._data.cam_xpos)
-        # Warp's kernels go on a torch stream: torch's current one, or with a CUDA graph the env's own (a
-        # stream torch made: torch captures only on its own, non-blocking streams).
+
+    def _prepare_graphs(self, cuda_graph: bool) -> None:
+        """Warp's kernels go on a torch stream: torch's current one, or with a CUDA graph the env's own (a
+        stream torch made: torch captures only on its own, non-blocking streams)."""
+        dev = self.device
         self._graph_stream = torch.cuda.Stream(dev) if cuda_graph else None
         self._stream = (wp.stream_from_torch(self._graph_stream or torch.cuda.current_stream(dev))
                         if dev.type == "cuda" else None)
         self._graphs: _StepGraphs | None = None  # the step's graphs, once captured
         self._capturing: _StepGraphs | None = None  # the graphs being captured, while they are
-        self._graph_actions = torch.zeros(n, dtype=torch.int64, device=dev)
+        self._graph_actions = torch.zeros(self.num_envs, dtype=torch.int64, device=dev)
         self._graph_outputs: tuple | None = None
         self._graph_error: RuntimeError | None = None  # why capturing failed, once it has
         self._eager_steps = 0
 
+    def _allocate_state(self) -> None:
+        """The per-world buffers a step writes in place (a captured graph replays on their storage)."""
+        n, dev, view = self.num_envs, self.device, self.view
         self._seed_keys = torch.zeros(n, dtype=torch.int64, device=dev)
         self._episodes = torch.zeros(n, dtype=torch.int64, device=dev)
         self._config_index = torch.zeros(n, dtype=torch.int64, device=dev)
@@ -238,7 +270,7 @@ class MazeBatchEnv(batch.BatchEnv):
         self._path = torch.zeros((n, doom.TICS_PER_STEP, 2), dtype=torch.float64, device=dev)
         self._turn_held = torch.zeros(n, dtype=torch.float64, device=dev)  # tics a turn key has been held
         self._bob = torch.zeros(n, dtype=torch.float64, device=dev)  # Doom's walking bob of the last tic
-        self._obs = torch.zeros((n, height, width, 3), dtype=torch.uint8, device=dev)
+        self._obs = torch.zeros((n, view.height, view.width, 3), dtype=torch.uint8, device=dev)
         self.state: dict[str, torch.Tensor] | None = None
 
     @property
