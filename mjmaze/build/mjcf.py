@@ -140,11 +140,32 @@ def build_xml(
     moved away per world); an object that collides drawn by a geom that does
     not and blocked by an undrawn twin that does (``<name>_collision``).
     """
-    batch = wall_layout_quads is not None
     if visual_style not in VISUAL_STYLES:
         raise ValueError(f"visual_style must be one of {VISUAL_STYLES}, got {visual_style!r}")
     root = ET.fromstring(template_path().read_text())
-    worldbody = root.find("worldbody")
+    worldbody, asset = root.find("worldbody"), root.find("asset")
+    _add_materials(root, room, visual_style)
+    # Model order is draw order: the walls before the floor, so floor pixels
+    # hidden by walls fail the depth test before any shading.
+    arena = _add_wall_mesh(worldbody, asset, grid_size, cell_size, wall_layout_quads)
+    _add_room(worldbody, grid_size, cell_size)
+    for k, (x, y, hx, hy) in enumerate(wall_boxes.wall_segments(grid_size, cell_size)):
+        ET.SubElement(
+            arena, "geom", name=walls.WALL_BOX_NAME.format(k), **{"class": "wall_collision"},
+            # Compiled in place: MuJoCo's midphase keeps the world body's
+            # geom bounding boxes from compile time, so boxes never move.
+            size=f"{hx} {hy} {wall_boxes.WALL_HEIGHT / 2}", pos=f"{x} {y} {wall_boxes.WALL_HEIGHT / 2}",
+        )
+    drawn = [(obj, _object_attributes(asset, obj, visual_style, width)) for obj in objects]
+    if wall_layout_quads is None:
+        _add_objects(worldbody, drawn)
+    else:
+        _add_batch_objects(arena, drawn)
+    return ET.tostring(root, encoding="unicode")
+
+
+def _add_materials(root: ET.Element, room: palette.Room, visual_style: str) -> None:
+    """The room's wall, floor and ceiling materials (and their textures in the textured style)."""
     asset = root.find("asset")
     for name in ("wall", "floor"):
         ET.SubElement(asset, "material", name=name, rgba=" ".join(f"{v:.3f}" for v in getattr(room, name)) + " 1",
@@ -153,22 +174,28 @@ def build_xml(
                   emission=f"{CEILING_GLOW - palette.AMBIENT}", specular="0", shininess="0", reflectance="0")
     if visual_style == "textured":
         _add_textures(root, room)
-    segments = wall_boxes.wall_segments(grid_size, cell_size)
 
-    if batch:
+
+def _add_wall_mesh(worldbody: ET.Element, asset: ET.Element, grid_size: int, cell_size: float,
+                   wall_layout_quads: Sequence[int] | None) -> ET.Element:
+    """The walls' visual mesh (one per layout for a batch); returns where the wall boxes and a batch's
+    objects go: the world body, or a batch's one mocap body."""
+    if wall_layout_quads is not None:
         arena = ET.SubElement(worldbody, "body", name=ARENA_BODY, mocap="true", pos="0 0 0")
         for layout, quads in enumerate(wall_layout_quads):  # overwritten after compiling (write_wall_mesh)
             walls.add_placeholder_mesh(asset, f"{walls.WALL_MESH}_{layout}", quads)
         ET.SubElement(arena, "geom", name=walls.WALL_VISUAL, type="mesh", mesh=f"{walls.WALL_MESH}_0", material="wall")
-    else:
-        arena = worldbody
-        # A placeholder mesh with room for the most quads any maze needs (every
-        # segment cut into pieces, all five quads each); WallLayout.apply overwrites
-        # it before first use.
-        walls.add_placeholder_mesh(asset, walls.WALL_MESH, walls.placeholder_quads(grid_size, cell_size))
-        ET.SubElement(worldbody, "geom", name=walls.WALL_VISUAL, type="mesh", mesh=walls.WALL_MESH, material="wall")
-    # The floor after the walls: MuJoCo draws geoms in model order, so floor
-    # pixels hidden by walls fail the depth test before any shading.
+        return arena
+    # A placeholder mesh with room for the most quads any maze needs (every
+    # segment cut into pieces, all five quads each); WallLayout.apply overwrites
+    # it before first use.
+    walls.add_placeholder_mesh(asset, walls.WALL_MESH, walls.placeholder_quads(grid_size, cell_size))
+    ET.SubElement(worldbody, "geom", name=walls.WALL_VISUAL, type="mesh", mesh=walls.WALL_MESH, material="wall")
+    return worldbody
+
+
+def _add_room(worldbody: ET.Element, grid_size: int, cell_size: float) -> None:
+    """The floor, the ceiling and the overhead camera."""
     half_extent = grid_size * cell_size / 2 + wall_boxes.WALL_THICKNESS
     # Plane grid spacing LIT_QUAD: finer grids cost llvmpipe more per frame.
     ET.SubElement(
@@ -189,34 +216,40 @@ def build_xml(
         worldbody, "camera", name=OVERHEAD_CAMERA, pos=f"0 0 {OVERHEAD_HEIGHT}", projection="orthographic",
         fovy=f"{overhead_extent(grid_size, cell_size)}",
     )
-    for k, (x, y, hx, hy) in enumerate(segments):
-        ET.SubElement(
-            arena, "geom", name=walls.WALL_BOX_NAME.format(k), **{"class": "wall_collision"},
-            # Compiled in place: MuJoCo's midphase keeps the world body's
-            # geom bounding boxes from compile time, so boxes never move.
-            size=f"{hx} {hy} {wall_boxes.WALL_HEIGHT / 2}", pos=f"{x} {y} {wall_boxes.WALL_HEIGHT / 2}",
-        )
-    colliding = []  # batch: (object, attributes) of the colliding objects, placed after the others
-    for obj in objects:  # see ObjectGeom
-        rgba = obj.rgba
-        attrs = dict(name=obj.name, type=obj.type, size=" ".join(map(str, obj.size)))
-        if obj.sprite is not None and visual_style == "textured":
-            attrs, rgba = _add_sprite(asset, obj, width)
-        attrs["rgba"] = " ".join(map(str, rgba))
-        if batch and obj.collides:
-            colliding.append((obj, attrs))
-        elif batch:
-            ET.SubElement(arena, "geom", **{"class": "item"}, pos=f"0 0 {obj.z}", group=str(VISIBLE_GROUP), **attrs)
-        elif obj.collides:
+
+
+def _object_attributes(asset: ET.Element, obj: ObjectGeom, visual_style: str, width: int) -> dict[str, str]:
+    """The geom attributes that draw ``obj`` (its sprite's quad and material in the textured style)."""
+    rgba = obj.rgba
+    attrs = dict(name=obj.name, type=obj.type, size=" ".join(map(str, obj.size)))
+    if obj.sprite is not None and visual_style == "textured":
+        attrs, rgba = _add_sprite(asset, obj, width)
+    attrs["rgba"] = " ".join(map(str, rgba))
+    return attrs
+
+
+def _add_objects(worldbody: ET.Element, drawn: list[tuple[ObjectGeom, dict]]) -> None:
+    """A CPU arena's objects: a colliding one in a mocap body of its own with its blocking twin, any
+    other a world geom (see :class:`ObjectGeom`)."""
+    for obj, attrs in drawn:
+        if obj.collides:
             body = ET.SubElement(worldbody, "body", name=obj.name, mocap="true", pos=f"0 0 {obj.z}")
             ET.SubElement(body, "geom", **{"class": "item"}, **attrs)
             ET.SubElement(body, "geom", **{"class": "item"}, **_blocking_square(obj))
         else:
             ET.SubElement(worldbody, "geom", **{"class": "item"}, pos=f"0 0 {obj.z}", **attrs)
-    for obj, attrs in colliding:
-        ET.SubElement(arena, "geom", **{"class": "item"}, pos=f"0 0 {obj.z}", group=str(VISIBLE_GROUP), **attrs)
-        ET.SubElement(arena, "geom", **{"class": "item"}, pos=f"0 0 {obj.z}", **_blocking_square(obj))
-    return ET.tostring(root, encoding="unicode")
+
+
+def _add_batch_objects(arena: ET.Element, drawn: list[tuple[ObjectGeom, dict]]) -> None:
+    """A batch's objects, all drawn, in the arena's body: the others first, then each colliding one
+    followed by its blocking twin."""
+    for obj, attrs in drawn:
+        if not obj.collides:
+            ET.SubElement(arena, "geom", **{"class": "item"}, pos=f"0 0 {obj.z}", group=str(VISIBLE_GROUP), **attrs)
+    for obj, attrs in drawn:
+        if obj.collides:
+            ET.SubElement(arena, "geom", **{"class": "item"}, pos=f"0 0 {obj.z}", group=str(VISIBLE_GROUP), **attrs)
+            ET.SubElement(arena, "geom", **{"class": "item"}, pos=f"0 0 {obj.z}", **_blocking_square(obj))
 
 
 def _blocking_square(obj: ObjectGeom) -> dict[str, str]:
