@@ -669,6 +669,25 @@ def _place_two_colour_things(task, physics, things: tuple[list, bool | None], fl
 
 
 def main() -> None:
+    args = _parser().parse_args()
+    if args.mazes is not None and args.mazes < 1:
+        raise SystemExit(f"error: --mazes must be 1 or more, got {args.mazes}")
+    mazes = args.mazes or (64 if args.swap else 8)
+    try:
+        wad = freedoom_path(args.freedoom)
+    except FileNotFoundError as error:
+        raise SystemExit(f"error: {error}") from None
+    for probe, report in _PROBES.items():  # at most one probe, instead of scoring the agents
+        if getattr(args, probe):
+            try:
+                report(args, mazes, wad)
+            except ValueError as error:
+                raise SystemExit(f"error: {error}") from None
+            return
+    _score_agents(args, wad)
+
+
+def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("checkout", type=pathlib.Path, help="a checkout of the released repository")
     parser.add_argument("--only", nargs="+", default=None, metavar="SETTING", help="e.g. labyrinth_9 two_colour_1")
@@ -705,77 +724,75 @@ def main() -> None:
     parser.add_argument("--freedoom", default="paper", metavar="paper|vizdoom|PATH",
                         help="the game data: paper (default: Freedoom 0.10.1, as the paper's ViZDoom 1.1.4 had it; "
                              "fetched once), vizdoom (the installed ViZDoom's own), or a freedoom2.wad")
-    args = parser.parse_args()
-    if args.mazes is not None and args.mazes < 1:
-        raise SystemExit(f"error: --mazes must be 1 or more, got {args.mazes}")
-    mazes = args.mazes or (64 if args.swap else 8)
-    try:
-        wad = freedoom_path(args.freedoom)
-    except FileNotFoundError as error:
-        raise SystemExit(f"error: {error}") from None
-    if args.agreement:
-        scenario = paper_agents.get(args.agreement).scenario
-        if scenario not in ("labyrinth", "two_colour"):
-            raise SystemExit("error: --agreement takes a Labyrinth or Two-colour agent (labyrinth_7 .. two_colour_7)")
-        share, shifted, gap = agreement(args.agreement, str(args.checkout), mazes=mazes, wad=wad)
-        print(f"{args.agreement}: the same action at {share:.1%} of the poses of its ViZDoom episodes (first "
-              f"{mazes} test mazes); on ViZDoom's own frames moved 1 pixel sideways: {shifted:.1%}")
-        print(f"  the frames' mean grey difference at those poses: {gap['pixel']:.2f} per pixel, {gap['block']:.2f} "
-              f"in 8x8 blocks, {gap['column']:.2f} per column")
-        if scenario == "two_colour":
-            print("  by the totem's colour: " + ", ".join(f"{totem} {share:.1%} of {poses} poses"
-                                                      for totem, (share, poses) in sorted(gap["by_totem"].items())))
-            hidden = agreement(args.agreement, str(args.checkout), mazes=mazes, hide_items=True, wad=wad)[0]
-            print(f"  with mjmaze's items hidden: {hidden:.1%}")
-        return
-    if args.blink:
-        table = blink(args.blink, str(args.checkout), mazes=mazes, wad=wad)
-        print(f"{args.blink}, a random walk of 300 steps on each of the first {mazes} test mazes: items seen "
-              "0.8-5 m ahead, the share of observations showing their fullbright picture")
-        for engine, rows in table.items():
-            print(f"  {engine}: " + ", ".join(f"{doom} {row['bright']:.0%} of {row['sightings']}"
-                                              for doom, row in sorted(rows.items())))
-        return
-    if args.swap:
-        try:
-            ends = swap(args.swap, str(args.checkout), args.sight, mazes=mazes, plays=args.plays,
-                        wad=wad)
-        except ValueError as error:
-            raise SystemExit(f"error: {error}") from None
-        total = sum(ends.values())
-        print(f"{args.swap}, seeing {args.sight}: {total} episodes to the first reward on the first "
-              f"{mazes} test mazes: " + ", ".join(f"{k} {v} ({v / total:.1%})" for k, v in ends.items()))
-        return
-    if args.along:
-        try:
-            result = along(args.along, str(args.checkout), mazes=mazes, wad=wad)
-        except ValueError as error:
-            raise SystemExit(f"error: {error}") from None
-        print(f"{args.along}, {result['steps']} steps of mjmaze's episodes on the first {mazes} test mazes (to the "
-              f"first reward): the same action on ViZDoom's frames at {result['same']:.1%}; where not, mjmaze's frame "
-              f"with ViZDoom's memory acts as ViZDoom at {result['memory']:.1%}, ViZDoom's frame with mjmaze's memory "
-              f"at {result['frame']:.1%}; the memories {result['memory_gap']:.2f} apart (relative)")
-        return
-    if args.motion:
-        rows = motion(args.motion, str(args.checkout), mazes=mazes, wad=wad)
-        miss = rows[:, 0]
-        print(f"{args.motion}, {len(rows)} steps of the first {mazes} test mazes: mjmaze's step lands "
-              f"{miss.mean():.2f} map units from ViZDoom's on average (median {np.median(miss):.2f}, 99th "
-              f"percentile {np.percentile(miss, 99):.1f}); over 4 units at {(miss > 4).mean():.1%} of steps, over 16 "
-              f"at {(miss > 16).mean():.1%}; mean move ViZDoom {rows[:, 1].mean():.2f}, mjmaze {rows[:, 2].mean():.2f}")
-        return
-    if args.picks:
-        try:
-            table = picks(args.picks, str(args.checkout), wad=wad)
-        except ValueError as error:
-            raise SystemExit(f"error: {error}") from None
-        print(f"{args.picks}, first 32 test mazes twice: | engine | totem | episodes | tics | right | wrong "
-              "(per 100 tics) |")
-        for engine, rows in table.items():
-            for label, row in rows.items():
-                print(f"| {engine} | {label} | {row['episodes']} | {row['tics']:.0f} | {row['right']:.2f} | "
-                      f"{row['wrong']:.2f} |")
-        return
+    return parser
+
+
+def _report_agreement(args, mazes: int, wad) -> None:
+    scenario = paper_agents.get(args.agreement).scenario
+    if scenario not in ("labyrinth", "two_colour"):
+        raise SystemExit("error: --agreement takes a Labyrinth or Two-colour agent (labyrinth_7 .. two_colour_7)")
+    share, shifted, gap = agreement(args.agreement, str(args.checkout), mazes=mazes, wad=wad)
+    print(f"{args.agreement}: the same action at {share:.1%} of the poses of its ViZDoom episodes (first "
+          f"{mazes} test mazes); on ViZDoom's own frames moved 1 pixel sideways: {shifted:.1%}")
+    print(f"  the frames' mean grey difference at those poses: {gap['pixel']:.2f} per pixel, {gap['block']:.2f} "
+          f"in 8x8 blocks, {gap['column']:.2f} per column")
+    if scenario == "two_colour":
+        print("  by the totem's colour: " + ", ".join(f"{totem} {share:.1%} of {poses} poses"
+                                                  for totem, (share, poses) in sorted(gap["by_totem"].items())))
+        hidden = agreement(args.agreement, str(args.checkout), mazes=mazes, hide_items=True, wad=wad)[0]
+        print(f"  with mjmaze's items hidden: {hidden:.1%}")
+
+
+def _report_blink(args, mazes: int, wad) -> None:
+    table = blink(args.blink, str(args.checkout), mazes=mazes, wad=wad)
+    print(f"{args.blink}, a random walk of 300 steps on each of the first {mazes} test mazes: items seen "
+          "0.8-5 m ahead, the share of observations showing their fullbright picture")
+    for engine, rows in table.items():
+        print(f"  {engine}: " + ", ".join(f"{doom} {row['bright']:.0%} of {row['sightings']}"
+                                          for doom, row in sorted(rows.items())))
+
+
+def _report_swap(args, mazes: int, wad) -> None:
+    ends = swap(args.swap, str(args.checkout), args.sight, mazes=mazes, plays=args.plays, wad=wad)
+    total = sum(ends.values())
+    print(f"{args.swap}, seeing {args.sight}: {total} episodes to the first reward on the first "
+          f"{mazes} test mazes: " + ", ".join(f"{k} {v} ({v / total:.1%})" for k, v in ends.items()))
+
+
+def _report_along(args, mazes: int, wad) -> None:
+    result = along(args.along, str(args.checkout), mazes=mazes, wad=wad)
+    print(f"{args.along}, {result['steps']} steps of mjmaze's episodes on the first {mazes} test mazes (to the "
+          f"first reward): the same action on ViZDoom's frames at {result['same']:.1%}; where not, mjmaze's frame "
+          f"with ViZDoom's memory acts as ViZDoom at {result['memory']:.1%}, ViZDoom's frame with mjmaze's memory "
+          f"at {result['frame']:.1%}; the memories {result['memory_gap']:.2f} apart (relative)")
+
+
+def _report_motion(args, mazes: int, wad) -> None:
+    rows = motion(args.motion, str(args.checkout), mazes=mazes, wad=wad)
+    miss = rows[:, 0]
+    print(f"{args.motion}, {len(rows)} steps of the first {mazes} test mazes: mjmaze's step lands "
+          f"{miss.mean():.2f} map units from ViZDoom's on average (median {np.median(miss):.2f}, 99th "
+          f"percentile {np.percentile(miss, 99):.1f}); over 4 units at {(miss > 4).mean():.1%} of steps, over 16 "
+          f"at {(miss > 16).mean():.1%}; mean move ViZDoom {rows[:, 1].mean():.2f}, mjmaze {rows[:, 2].mean():.2f}")
+
+
+def _report_picks(args, mazes: int, wad) -> None:
+    table = picks(args.picks, str(args.checkout), wad=wad)
+    print(f"{args.picks}, first 32 test mazes twice: | engine | totem | episodes | tics | right | wrong "
+          "(per 100 tics) |")
+    for engine, rows in table.items():
+        for label, row in rows.items():
+            print(f"| {engine} | {label} | {row['episodes']} | {row['tics']:.0f} | {row['right']:.2f} | "
+                  f"{row['wrong']:.2f} |")
+
+
+#: The probes (``--agreement`` ...), each instead of scoring the agents, in the order they are looked for.
+_PROBES = {"agreement": _report_agreement, "blink": _report_blink, "swap": _report_swap, "along": _report_along,
+           "motion": _report_motion, "picks": _report_picks}
+
+
+def _score_agents(args, wad) -> None:
+    """The 16 agents (or ``--only``) on the released mazes, both splits, into ``--out`` after each job."""
     names = args.only or list(paper_agents.AGENTS)
     for name in names:
         paper_agents.get(name)  # a bad name fails before anything runs
