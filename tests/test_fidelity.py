@@ -18,7 +18,7 @@ from conftest import FORWARD, place
 import mjmaze
 from mjmaze.build import mjcf, palette, sprites, walls
 from mjmaze.drawing import render
-from mjmaze.game import core, doom, layouts, registry, wall_boxes
+from mjmaze.game import core, doom, layouts, wall_boxes
 from mjmaze.scenarios import find_return, k_item, two_colour
 
 STEP = -0.0004
@@ -116,8 +116,8 @@ def test_wall_textures_start_again_at_each_grid_line_as_the_released_blocks_do()
 
 
 def room_of(task) -> palette.Room:
-    """The room ``task``'s scenario declares (its view asks for none other)."""
-    return palette.ROOMS[registry.get(task.rules.scenario).room]
+    """The room ``task``'s frames show (its scenario's: the view asks for none other)."""
+    return palette.ROOMS[task.view.room]
 
 
 def flat_views(task, centre, extent=1.0, pixels=128):

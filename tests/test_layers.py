@@ -120,6 +120,7 @@ def test_the_old_module_paths_import_for_one_more_release_with_a_warning():
 
 def test_the_core_is_rules_on_every_backend_and_the_old_task_name_still_reads_for_a_release():
     import dataclasses
+    import warnings
 
     import gymnasium
 
@@ -132,12 +133,17 @@ def test_the_core_is_rules_on_every_backend_and_the_old_task_name_still_reads_fo
     finally:
         env.close()
     declared = registry.get("labyrinth")
+    with pytest.warns(DeprecationWarning, match="Scenario.rules"):
+        assert declared.task is declared.rules
     fields = {field.name: getattr(declared, field.name) for field in dataclasses.fields(declared)}
     fields["task"] = fields.pop("rules")
     with pytest.warns(DeprecationWarning, match="rules="):
         assert registry.Scenario(**fields) == declared
-    with pytest.raises(TypeError, match="needs rules="):
-        registry.Scenario(**{**fields, "task": None})
+    with pytest.warns(DeprecationWarning, match="rules="):  # the old way to derive one, as tests did
+        assert dataclasses.replace(declared, task=dict).rules is dict
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DeprecationWarning)
+        assert dataclasses.replace(declared, name="other").rules is declared.rules
 
 
 def test_a_scenario_declares_its_room_and_an_unknown_one_is_refused_at_registration():

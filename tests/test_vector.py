@@ -30,6 +30,26 @@ FAILING = dataclasses.replace(labyrinth.SCENARIO, name="failing_labyrinth", rule
                               gym_id="mjmaze_test/FailingLabyrinth-v0", seed_code=1002)
 
 
+class QuickClock(labyrinth.Labyrinth):
+    """Labyrinth whose episodes start three steps before the time limit: a worker's autoreset in
+    milliseconds, not 525 steps."""
+
+    def start_state(self, xp, config, keys):
+        state = super().start_state(xp, config, keys)
+        state["steps"] = state["steps"] + (core.EPISODE_STEPS - 3)
+        return state
+
+
+QUICK_CLOCK = dataclasses.replace(labyrinth.SCENARIO, name="quick_clock_labyrinth", rules=QuickClock,
+                                  gym_id="mjmaze_test/QuickClockLabyrinth-v0", seed_code=1004)
+
+
+@pytest.fixture
+def quick_clock(monkeypatch):
+    monkeypatch.setattr(registry, "_SCENARIOS", dict(registry._SCENARIOS))
+    return suite.register(QUICK_CLOCK)
+
+
 @pytest.fixture
 def failing(monkeypatch):
     """:data:`FAILING` registered for one test only (every other test reads the registry)."""
@@ -99,6 +119,19 @@ def test_next_step_autoreset():
     assert (rewards == 0).all() and not (terminated | truncated).any()
     assert (infos["step"] == 0).all() and (infos["episode_return"] == 0).all()
     assert not np.array_equal(obs, last_frames)
+    envs.close()
+
+
+def test_a_worker_restarts_its_envs_at_the_time_limit_on_the_next_step(quick_clock):
+    envs = MazeVectorEnv(2, "quick_clock_labyrinth", size=5, num_workers=1, step_in_caller=False)
+    _, infos = envs.reset(seed=1)
+    assert (infos["step"] == core.EPISODE_STEPS - 3).all()
+    for step in range(core.EPISODE_STEPS - 2, core.EPISODE_STEPS + 1):
+        obs, rewards, terminated, truncated, infos = envs.step(np.full(2, TURN_LEFT))
+        assert (infos["step"] == step).all() and truncated.all() == (step == core.EPISODE_STEPS)
+    obs, rewards, terminated, truncated, infos = envs.step(np.full(2, 2))  # the action is ignored
+    assert (rewards == 0).all() and not (terminated | truncated).any()
+    assert (infos["step"] == core.EPISODE_STEPS - 3).all() and (infos["episode_return"] == 0).all()
     envs.close()
 
 

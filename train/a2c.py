@@ -9,7 +9,7 @@ Everything a run writes goes to ``runs/<name>/``: ``config.json``, ``metrics.jso
 final, written atomically, the last few kept). Ctrl-C or SIGTERM saves a final
 checkpoint before exiting.
 
-The algorithm, top to bottom in :func:`train`: 16 envs x 128 steps per update;
+The algorithm (:class:`_Learner`'s rollout and update): 16 envs x 128 steps per update;
 the env autoresets in the same step (the returned frame starts the next
 episode, so the GRU memory is wiped there); n-step returns bootstrapped from the
 value of the last frame, cut at every episode end (the time limit included, as
@@ -174,33 +174,41 @@ class _Learner:
                         rewards=torch.zeros(shape, device=self.buffers), dones=torch.zeros(shape, device=self.buffers))
         agent, device = self.agent, self.device
         torch.set_num_threads(self.rollout_threads)
-        for t in range(self.args.num_steps):
-            # The rollout's forward pass is the update's: the parameters do
-            # not change within a rollout, so its graph is kept for the
-            # backward pass instead of being recomputed (the same gradients;
-            # tests/test_train.py checks it). The graph holds ~90 KB per frame.
-            features = agent.features(torch.as_tensor(self.obs).to(device))
-            logits, value, self.hidden = agent.step(features, self.hidden, self.episode_starts.to(device))
-            done.logits.append(logits)
-            done.values.append(value)
-            with torch.no_grad():
-                action = torch.multinomial(F.softmax(logits, dim=-1), 1).squeeze(1)
-            env_started = time.perf_counter()
-            action = action.to(self.buffers)
-            # The Warp backend takes the device's tensor, the CPU envs a numpy array.
-            self.obs, reward, terminated, truncated, infos = envs.step(
-                action if self.args.backend == "warp" else action.numpy())
-            done.env_seconds += time.perf_counter() - env_started
-            ended = torch.as_tensor(terminated | truncated)
-            done.actions[t] = action
-            done.rewards[t] = torch.as_tensor(reward)
-            done.dones[t] = ended
-            self.episode_starts = ended
-            if "final_info" in infos:
-                # One copy to the host per field (the Warp backend's are on the GPU), not one per value.
-                final = {k: torch.as_tensor(v).cpu() for k, v in infos["final_info"].items() if not k.startswith("_")}
-                for i in torch.nonzero(ended).flatten().tolist():
-                    done.finished.append({k: v[i].item() for k, v in final.items()})
+        try:
+            for t in range(self.args.num_steps):
+                # The rollout's forward pass is the update's: the parameters do
+                # not change within a rollout, so its graph is kept for the
+                # backward pass instead of being recomputed (the same gradients;
+                # tests/test_train.py checks it). The graph holds ~90 KB per frame.
+                features = agent.features(torch.as_tensor(self.obs).to(device))
+                logits, value, self.hidden = agent.step(features, self.hidden, self.episode_starts.to(device))
+                done.logits.append(logits)
+                done.values.append(value)
+                with torch.no_grad():
+                    action = torch.multinomial(F.softmax(logits, dim=-1), 1).squeeze(1)
+                env_started = time.perf_counter()
+                action = action.to(self.buffers)
+                # The Warp backend takes the device's tensor, the CPU envs a numpy array.
+                self.obs, reward, terminated, truncated, infos = envs.step(
+                    action if self.args.backend == "warp" else action.numpy())
+                done.env_seconds += time.perf_counter() - env_started
+                ended = torch.as_tensor(terminated | truncated)
+                done.actions[t] = action
+                done.rewards[t] = torch.as_tensor(reward)
+                done.dones[t] = ended
+                self.episode_starts = ended
+                if "final_info" in infos:
+                    # One copy to the host per field (the Warp backend's are on the GPU), not one per value.
+                    final = {k: torch.as_tensor(v).cpu() for k, v in infos["final_info"].items() if not k.startswith("_")}
+                    for i in torch.nonzero(ended).flatten().tolist():
+                        done.finished.append({k: v[i].item() for k, v in final.items()})
+        except WorkerError:
+            # Nothing holds the cut rollout's graph (~90 KB a frame) while the envs are rebuilt.
+            done.logits.clear()
+            done.values.clear()
+            features = logits = value = None  # noqa: F841 - this frame outlives the raise in the traceback
+            self.hidden = self.hidden.detach()
+            raise
         return done
 
     def update(self, rollout: _Rollout) -> dict:

@@ -103,7 +103,7 @@ def _split(name: str, task_kwargs: dict | None) -> tuple[dict, dict, dict]:
 def make_task(name: str, task_kwargs: dict | None = None) -> base.MazeTask:
     """The dm_control task of scenario ``name`` (no physics, no rendering yet); checks its arguments."""
     rules_kwargs, view_kwargs, own = _split(name, task_kwargs)
-    return base.MazeTask(registry.get(name).rules(**rules_kwargs), look.View(**view_kwargs), **own)
+    return base.MazeTask(registry.get(name).rules(**rules_kwargs), _view(name, view_kwargs), **own)
 
 
 def make_rules(name: str, task_kwargs: dict | None = None) -> core.MazeRules:
@@ -118,7 +118,13 @@ def make_rules(name: str, task_kwargs: dict | None = None) -> core.MazeRules:
 
 def make_view(name: str, task_kwargs: dict | None = None) -> look.View:
     """How scenario ``name``'s frames look, from its task arguments (all checked; see :func:`make_rules`)."""
-    return look.View(**_split(name, task_kwargs)[1])
+    return _view(name, _split(name, task_kwargs)[1])
+
+
+def _view(name: str, view_kwargs: dict) -> look.View:
+    """The view the arguments ask for, in scenario ``name``'s room unless they name another."""
+    view = look.View(**view_kwargs)
+    return view if view.room is not None else dataclasses.replace(view, room=registry.get(name).room)
 
 
 def load(name: str, task_kwargs: dict | None = None, environment_kwargs: dict | None = None) -> control.Environment:

@@ -85,15 +85,16 @@ def build_model(rules: core.MazeRules, view: look.View) -> tuple[mujoco.MjModel,
     return model, ids, mesh_of_config, box_z
 
 
-def cuda_graph_problem(device_type: str, restart_by_index: bool, conditional_graphs: bool, mempool: bool) -> str | None:
-    """Why ``cuda_graph=True`` cannot run on a device with these facts (None: it can).
+def cuda_graph_problem(device: str, restart_by_index: bool, conditional_graphs: bool, mempool: bool) -> str | None:
+    """Why ``cuda_graph=True`` cannot run on ``device`` (``"cuda"``, ``"cuda:1"``, ``"cpu"``) with these
+    facts (None: it can).
 
     ``conditional_graphs``: the driver and toolkit capture conditional nodes (MuJoCo Warp's solver
     loop); ``mempool``: Warp's memory pool is on for the device (MuJoCo Warp allocates inside a step).
     A pure function of the facts, so the checks a GPU runs are tested on any machine.
     """
-    if device_type != "cuda":
-        return f"cuda_graph=True needs a CUDA device; got a {device_type!r} device"
+    if not device.startswith("cuda"):
+        return f"cuda_graph=True needs a CUDA device; got device={device!r}"
     if not conditional_graphs:
         return ("cuda_graph=True needs CUDA graphs with conditional nodes (MuJoCo Warp's solver loop): "
                 "a CUDA 12.4+ driver and toolkit; pass cuda_graph=False")
@@ -183,7 +184,7 @@ class MazeBatchEnv(batch.BatchEnv):
             restart_by_index = rules.costly_start and self.device.type == "cpu"
         self.restart_by_index = bool(restart_by_index)
         if cuda_graph:
-            problem = cuda_graph_problem(self.device.type, self.restart_by_index, *_graph_facts(self._wp_device))
+            problem = cuda_graph_problem(str(device), self.restart_by_index, *_graph_facts(self._wp_device))
             if problem:
                 raise ValueError(problem)
         self.xp = arrays.namespace(torch.zeros(1))

@@ -21,7 +21,7 @@ import mujoco
 import numpy as np
 
 from mjmaze.build import mjcf, palette, walls
-from mjmaze.game import configs, registry, wall_boxes
+from mjmaze.game import configs, wall_boxes
 
 
 @dataclasses.dataclass(frozen=True)
@@ -62,7 +62,8 @@ class Arena:
 
     def __init__(self, rules, view, layouts: Sequence[configs.MazeConfig] | None = None):
         self.objects = tuple(rules.objects)
-        self.room = palette.ROOMS[view.room or registry.get(rules.scenario).room]
+        # The view names the room (suite.make_view fills in the scenario's); a bare View gets Doom's stone room.
+        self.room = palette.ROOMS[view.room or "stone"]
         self.cell_size, self.view = rules.layout.cell_size, view
         self.layouts = None if layouts is None else list(layouts)
         quads = None if layouts is None else [walls.wall_mesh_quads(c.h_walls, c.v_walls, self.cell_size)

@@ -20,11 +20,9 @@ import mujoco
 import numpy as np
 
 from mjmaze.build import palette, sprites, walls
-from mjmaze.game import wall_boxes
+from mjmaze.game import doom, wall_boxes
 
 #: ``visual_style`` values: "textured" (the default) gives walls and floor
-from mjmaze.game import doom
-
 #: textures whose texels keep their size in the world and light that falls off
 #: with distance, the depth cues of the paper's ViZDoom frames; "flat" gives
 #: single-colour surfaces under a headlight, cheaper to render.
@@ -148,7 +146,7 @@ def build_xml(
     # Model order is draw order: the walls before the floor, so floor pixels
     # hidden by walls fail the depth test before any shading.
     arena = _add_wall_mesh(worldbody, asset, grid_size, cell_size, wall_layout_quads)
-    _add_room(worldbody, grid_size, cell_size)
+    _add_floor_ceiling_and_map_camera(worldbody, grid_size, cell_size)
     for k, (x, y, hx, hy) in enumerate(wall_boxes.wall_segments(grid_size, cell_size)):
         ET.SubElement(
             arena, "geom", name=walls.WALL_BOX_NAME.format(k), **{"class": "wall_collision"},
@@ -194,7 +192,7 @@ def _add_wall_mesh(worldbody: ET.Element, asset: ET.Element, grid_size: int, cel
     return worldbody
 
 
-def _add_room(worldbody: ET.Element, grid_size: int, cell_size: float) -> None:
+def _add_floor_ceiling_and_map_camera(worldbody: ET.Element, grid_size: int, cell_size: float) -> None:
     """The floor, the ceiling and the overhead camera."""
     half_extent = grid_size * cell_size / 2 + wall_boxes.WALL_THICKNESS
     # Plane grid spacing LIT_QUAD: finer grids cost llvmpipe more per frame.

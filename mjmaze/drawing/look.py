@@ -45,8 +45,9 @@ class View:
     #: ViZDoom drew no weapon in any of the paper's scenarios, so none is drawn by default (the ``-v0``
     #: ids drew one; ViZDoom's own maps show it, as ``tools/doom_frames.py``'s probes do).
     pistol: bool = False
-    #: Another room than the scenario's (:data:`mjmaze.build.palette.ROOMS`: ``"stone"``, ``"slime"``);
-    #: None: the scenario's own (:attr:`mjmaze.game.registry.Scenario.room`).
+    #: The room (:data:`mjmaze.build.palette.ROOMS`: ``"stone"``, ``"slime"``). None: the scenario's own
+    #: (:attr:`mjmaze.game.registry.Scenario.room`, which :func:`mjmaze.backends.suite.make_view` fills in),
+    #: Doom's stone room for a view made without a scenario.
     room: str | None = None
 
     def __post_init__(self):
@@ -86,7 +87,7 @@ PISTOL_BOB_TICS = 64
 PISTOL_BOB_PIXELS = (0.751 / 320, 0.903 / 180)  # (x, y) shift per unit of bob, as fractions of the frame
 
 # The pistol ViZDoom draws over the bottom of the view where a map gives the
-# player one (none of the released maps does: mjmaze.game.core.MazeRules.pistol):
+# player one (none of the released maps does: View.pistol):
 # Freedoom's pistol and hand, ~3% of a 112x64 frame. Drawn as its two parts'
 # boxes, (left, right, top, bottom) as fractions of the frame, in their mean
 # colours as ViZDoom draws them.

@@ -18,7 +18,7 @@ import dataclasses
 import warnings
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
+@dataclasses.dataclass(frozen=True)
 class Scenario:
     """One scenario's declaration.
 
@@ -52,7 +52,7 @@ class Scenario:
     """
 
     name: str
-    rules: type | None = None
+    rules: type
     gym_id: str
     seed_code: int
     difficulty: str
@@ -64,19 +64,28 @@ class Scenario:
     item_codes: tuple[str, ...] | None = None
     imported_spawn_may_share_a_cell: bool = False
     room: str = "stone"
-    #: 0.1's name of ``rules``: accepted one more release (0.2), with a warning. An init-only
-    #: argument, not a field (``dataclasses.replace`` reads the class's ``None``).
-    task: dataclasses.InitVar[type | None] = None
 
-    def __post_init__(self, task: type | None) -> None:
-        if task is not None:
-            warnings.warn("Scenario(task=...) is Scenario(rules=...) since mjmaze 0.2; task= goes in 0.3",
-                          DeprecationWarning, stacklevel=3)
-            if self.rules is not None and self.rules is not task:
-                raise TypeError(f"scenario {self.name!r}: give rules=, not both rules= and task=")
-            object.__setattr__(self, "rules", task)
-        if self.rules is None:
-            raise TypeError(f"scenario {self.name!r} needs rules=: its MazeRules subclass")
+
+# 0.1 named ``rules`` ``task``: ``Scenario(task=...)`` and ``.task`` work until 0.3, with a warning.
+_dataclass_init = Scenario.__init__
+
+
+def _init(self, *args, task: type | None = None, **kwargs) -> None:
+    if task is not None:
+        warnings.warn("Scenario(task=...) is Scenario(rules=...) since mjmaze 0.2; task= goes in 0.3",
+                      DeprecationWarning, stacklevel=2)
+        kwargs["rules"] = task  # over dataclasses.replace's copy of the old rules
+    _dataclass_init(self, *args, **kwargs)
+
+
+def _task(self) -> type:
+    warnings.warn("Scenario.task is Scenario.rules since mjmaze 0.2; .task goes in 0.3", DeprecationWarning,
+                  stacklevel=2)
+    return self.rules
+
+
+Scenario.__init__ = _init  # type: ignore[method-assign]
+Scenario.task = property(_task)  # type: ignore[attr-defined]
 
 
 _SCENARIOS: dict[str, Scenario] = {}
