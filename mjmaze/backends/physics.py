@@ -154,7 +154,11 @@ class MazePhysics(mujoco.Physics):
         model.geom_pos[ids[~in_body], :2] = xy[~in_body]
 
     def show_objects(self, geom_ids, visible) -> None:
-        """Shows (True) or hides (False) objects in the agent's view."""
+        """Shows (True) or hides (False) objects in the agent's view.
+
+        By the geom's group, MuJoCo's one per-geom switch that the renderers read (they draw groups 0-2):
+        the CPU physics owns its model, so the object sync writes it here, as it moves the objects.
+        """
         self.model.ptr.geom_group[geom_ids] = np.where(visible, VISIBLE_GROUP, mjcf.HIDDEN_GROUP)
 
     def set_object_rgba(self, geom_id: int, rgba) -> None:

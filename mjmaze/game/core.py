@@ -69,7 +69,11 @@ class EpisodeState(TypedDict, total=False):
 class MazeRules(abc.ABC):
     """Base of every scenario: its settings, configurations and rules; see the module docstring."""
 
-    #: Objects this scenario adds to the arena.
+    #: Objects this scenario adds to the arena. Each is one declaration (a :class:`mjmaze.build.mjcf.ObjectGeom`),
+    #: as a Doom thing is one thing: the square it blocks with, how it is drawn, and its sprite's frame
+    #: tics, which time its animation from :meth:`animation_start` (drawn with the episode's other draws,
+    #: so both backends agree). The rules read only how many there are and those tics; splitting the
+    #: picture from the rest would keep two lists aligned by index.
     objects: Sequence[mjcf.ObjectGeom] = ()
     #: The scenario's name, as passed to ``mjmaze.load`` (it also enters the maze seeds).
     scenario: str = ""
