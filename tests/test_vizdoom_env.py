@@ -97,6 +97,37 @@ def test_two_colour_pays_the_released_training_reward_and_counts_tics(vizdoom):
         env.close()
 
 
+def test_frames_are_resized_as_the_released_call_did_it_bilinear(vizdoom):
+    import cv2
+
+    env = released_env()
+    try:
+        released, _ = env.reset(seed=0)
+        screen = env._game.get_state().screen_buffer.transpose(1, 2, 0)
+        # doom_environment.py's own call: its third argument is OpenCV's dst, not the interpolation.
+        assert np.array_equal(released, cv2.resize(screen, vizdoom_env.FRAME_SIZE, cv2.INTER_AREA))
+        assert np.array_equal(released, vizdoom_env.frame(env._game, "released"))
+        area = vizdoom_env.frame(env._game, "area")
+        assert np.abs(area.astype(int) - released).mean() > 1.0  # what the call meant is another frame
+    finally:
+        env.close()
+    with pytest.raises(ValueError, match="resize must be one of"):
+        vizdoom_env.make_vector_env(2, "two_colour", 1, released_dir=RELEASED, resize="nearest")
+
+
+def test_a_vizdoom_run_saved_before_resize_existed_goes_on_with_area_frames():
+    from mjmaze.train import checkpoint, engines
+
+    old = {"scenario": "two_colour", "complexity": 1, "engine": "vizdoom", "env_id": "vizdoom:two_color/1@paper"}
+    assert checkpoint.setting_of(old, "resize") == "area"
+    assert checkpoint.identity_differences(old, {**old, "resize": "released"}) == {"resize": ("area", "released")}
+    assert engines.env_id(old) == "vizdoom:two_color/1@paper+area"
+    assert engines.env_id({**old, "resize": "released"}) == "vizdoom:two_color/1@paper"
+    # mjmaze's own runs never read it: one saved before it existed resumes as it is.
+    mjmaze_run = {"scenario": "labyrinth", "size": 5}
+    assert checkpoint.identity_differences(mjmaze_run, {**mjmaze_run, "engine": "mjmaze", "resize": "released"}) == {}
+
+
 def test_the_same_seed_plays_the_same_episode_and_another_seed_another(vizdoom):
     def frames(seed):
         env = released_env(first=0)

@@ -54,7 +54,8 @@ from mjmaze.backends import suite
 # released env set a game up, drew its frame and paid its metric.
 from mjmaze.backends.vizdoom_env import FRAME_SIZE as SIZE
 from mjmaze.backends.vizdoom_env import LIMITED_ACTIONS, episode_metrics, freedoom_path
-from mjmaze.backends.vizdoom_env import frame as _frame
+from mjmaze.backends.vizdoom_env import RESIZES
+from mjmaze.backends.vizdoom_env import frame as _resized_frame
 from mjmaze.backends.vizdoom_env import maze_seed as _maze_seed
 from mjmaze.backends.vizdoom_env import released_game as _game
 from mjmaze.build import sprites
@@ -74,7 +75,15 @@ def _metric(scenario: str, rewards: list[float], steps: int, difficulty: int) ->
     return float(episode_metrics(scenario, rewards, steps, difficulty)[suite.paper_metric(scenario)[0]])
 
 
-def play(job: tuple[str, str, str, int, int, int, str | None]) -> tuple[str, str, dict]:
+#: How this process resizes ViZDoom's screens (--resize; a pool worker is told in its job).
+_RESIZE = "released"
+
+
+def _frame(game) -> np.ndarray:
+    return _resized_frame(game, _RESIZE)
+
+
+def play(job: tuple[str, str, str, int, int, int, str | None, str]) -> tuple[str, str, dict]:
     """Plays one agent on one split's first 64 mazes, each ``plays`` times; returns ``(name, split, result)``.
 
     Maze ``i``'s game is seeded with ``seed * 1000 + i`` (Doom's random draws:
@@ -84,7 +93,8 @@ def play(job: tuple[str, str, str, int, int, int, str | None]) -> tuple[str, str
     sideways (0: as released), the probe's scale in closed loop: how far a
     score moves for a change no one would call an engine's.
     """
-    name, split, checkout, seed, plays_per_maze, shift, wad = job
+    global _RESIZE
+    name, split, checkout, seed, plays_per_maze, shift, wad, _RESIZE = job
     torch.set_num_threads(1)
     info = paper_agents.get(name)
     _, agent, _ = paper_agents.load(name, paper_dir=checkout)
@@ -669,7 +679,9 @@ def _place_two_colour_things(task, physics, things: tuple[list, bool | None], fl
 
 
 def main() -> None:
+    global _RESIZE
     args = _parser().parse_args()
+    _RESIZE = args.resize
     if args.mazes is not None and args.mazes < 1:
         raise SystemExit(f"error: --mazes must be 1 or more, got {args.mazes}")
     mazes = args.mazes or (64 if args.swap else 8)
@@ -721,6 +733,10 @@ def _parser() -> argparse.ArgumentParser:
                              "with the other's things")
     parser.add_argument("--mazes", type=int, default=None,
                         help="test mazes for --agreement, --along and --motion (default 8) and --swap (default 64)")
+    parser.add_argument("--resize", default="released", choices=tuple(RESIZES),
+                        help="how ViZDoom's 320x180 screen becomes 112x64: released (bilinear, what the released "
+                             "code's call did; default) or area (cv2.INTER_AREA, what docs/fidelity.md's ViZDoom "
+                             "column was measured with)")
     parser.add_argument("--freedoom", default="paper", metavar="paper|vizdoom|PATH",
                         help="the game data: paper (default: Freedoom 0.10.1, as the paper's ViZDoom 1.1.4 had it; "
                              "fetched once), vizdoom (the installed ViZDoom's own), or a freedoom2.wad")
@@ -805,10 +821,12 @@ def _score_agents(args, wad) -> None:
         raise SystemExit(f"error: --shift {args.shift} plays ViZDoom with moved frames: pass --out FILE other than "
                          f"{DEFAULT_OUT}")
     results = json.loads(args.out.read_text()) if args.out.exists() else {}  # kept: rerun only what is asked
-    jobs = [(name, split, str(args.checkout), args.seed, args.plays, args.shift, wad)
+    jobs = [(name, split, str(args.checkout), args.seed, args.plays, args.shift, wad, args.resize)
             for name in names for split in ("train", "test")]
+    # The results measured before --resize existed were INTER_AREA's: their engine string stays theirs.
     engine = (f"vizdoom {__import__('vizdoom').__version__}, freedoom "
-              f"{ {'paper': '0.10.1', 'vizdoom': 'as shipped'}.get(args.freedoom, args.freedoom)}")
+              f"{ {'paper': '0.10.1', 'vizdoom': 'as shipped'}.get(args.freedoom, args.freedoom)}"
+              + (", frames resized as released (bilinear)" if args.resize == "released" else ""))
     with mp.get_context("spawn").Pool(args.processes) as pool:
         for name, split, result in pool.imap_unordered(play, jobs):
             info = paper_agents.get(name)

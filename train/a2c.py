@@ -126,7 +126,7 @@ def training_envs(args: Args, device: torch.device) -> functools.partial:
 
         return functools.partial(
             vizdoom_env.make_vector_env, args.num_envs, args.scenario, args.difficulty_value(), split="train",
-            released_dir=args.released_dir, freedoom=args.freedoom, head_bob=args.head_bob,
+            released_dir=args.released_dir, freedoom=args.freedoom, head_bob=args.head_bob, resize=args.resize,
         )
     if args.backend == "warp":
         # The envs live on the network's device: observations never leave it.

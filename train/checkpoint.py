@@ -17,9 +17,11 @@ from mjmaze.files import atomic_write
 PREFIX, SUFFIX = "step_", ".pt"
 # What must agree between a checkpoint and the run that loads it.
 IDENTITY_KEYS = ("scenario", "size", "num_items", "complexity", "num_envs", "num_steps", "head_bob", "flashes",
-                 "engine", "freedoom")
-# Settings that runs saved before they existed ran with.
-MISSING_MEANS = {"head_bob": False, "flashes": False, "engine": "mjmaze", "freedoom": "paper"}
+                 "engine", "freedoom", "resize")
+# Settings that runs saved before they existed ran with (ViZDoom's frames: INTER_AREA until 2026-11-29).
+MISSING_MEANS = {"head_bob": False, "flashes": False, "engine": "mjmaze", "freedoom": "paper", "resize": "area"}
+# Settings that only the ViZDoom engine reads: an mjmaze run's value means nothing.
+VIZDOOM_ONLY = ("freedoom", "resize")
 
 
 def setting_of(config: dict, key: str):
@@ -29,8 +31,9 @@ def setting_of(config: dict, key: str):
 
 def identity_differences(saved: dict, now: dict) -> dict:
     """``{key: (saved value, value now)}`` of the :data:`IDENTITY_KEYS` that differ between two run configs."""
+    on_mjmaze = setting_of(saved, "engine") == setting_of(now, "engine") == "mjmaze"
     return {k: (setting_of(saved, k), setting_of(now, k)) for k in IDENTITY_KEYS
-            if setting_of(saved, k) != setting_of(now, k)}
+            if setting_of(saved, k) != setting_of(now, k) and not (on_mjmaze and k in VIZDOOM_ONLY)}
 
 
 class CheckpointError(RuntimeError):

@@ -55,6 +55,18 @@ def setting_name(config: dict) -> str:
     return f"{config['scenario']}_{difficulty}"
 
 
+def env_id(config: dict) -> str | None:
+    """What a run played: its config's ``env_id``; on ViZDoom, named from its settings (a run saved before
+    ``resize`` existed resized with INTER_AREA, which its saved id does not say)."""
+    if checkpoint.setting_of(config, "engine") != "vizdoom":
+        return config.get("env_id")
+    from mjmaze.backends import vizdoom_env
+
+    difficulty = config[registry.get(config["scenario"]).difficulty]
+    return vizdoom_env.engine_id(config["scenario"], difficulty, checkpoint.setting_of(config, "freedoom"),
+                                 checkpoint.setting_of(config, "resize"))
+
+
 def run_record(run_dir: pathlib.Path) -> dict:
     """A run's curve on the fixed grid of :data:`BIN_STEPS` bins (from the first time limit on) and its evaluations."""
     run = curves.read_run(run_dir)
@@ -72,7 +84,7 @@ def run_record(run_dir: pathlib.Path) -> dict:
         "setting": setting_name(config),
         "engine": checkpoint.setting_of(config, "engine"),
         "seed": int(config["seed"]),
-        "env_id": config.get("env_id"),
+        "env_id": env_id(config),
         "field": published.curve_field(config["scenario"]),
         "steps": int(run["steps"].max()),
         # Each bin's mean of the updates' training means (None where no episode ended), 4 significant digits.

@@ -80,6 +80,7 @@ def play_split(agent: Agent | None, args: Args, split: str, num_envs: int, devic
         envs = vizdoom_env.make_vector_env(
             num_envs, args.scenario, args.difficulty_value(), split=split, released_dir=args.released_dir,
             num_configs=num_configs, order="cycle", freedoom=args.freedoom, head_bob=args.head_bob,
+            resize=args.resize,
         )
     elif backend == "cpu":
         envs = MazeVectorEnv(

@@ -65,6 +65,8 @@ class _RunSettings:
     """with --engine vizdoom: a checkout of github.com/edbeeching/3d_control_deep_rl (None: $MJMAZE_PAPER_DIR)"""
     freedoom: str = "paper"
     """with --engine vizdoom: the game data: paper (Freedoom 0.10.1, fetched once), vizdoom (ViZDoom's own) or a freedoom2.wad"""
+    resize: str = "released"
+    """with --engine vizdoom: how the 320x180 screen becomes 112x64: released (bilinear, what the released code's cv2.resize call did) or area (cv2.INTER_AREA, what it meant; mjmaze's ViZDoom runs until 2026-11-29)"""
     cuda_graph: bool = False
     """with --backend warp on a GPU: replay each env step as one CUDA graph (mjmaze.backends.warp.MazeBatchEnv's cuda_graph)"""
     torch_threads: int | None = None
@@ -134,6 +136,7 @@ class _RunSettings:
         if unplayable:
             raise ValueError(f"--engine vizdoom plays the released mazes as released: it takes the difficulty and "
                              f"--no-head-bob, not {sorted(unplayable)}")
+        vizdoom_env.check_resize(self.resize)
         vizdoom_env.released_folder(self.scenario, self.difficulty_value(), "train", self.released_dir)
 
     def difficulty_value(self) -> int:
@@ -146,7 +149,7 @@ class _RunSettings:
         if self.engine == "vizdoom":
             from mjmaze.backends import vizdoom_env
 
-            return vizdoom_env.engine_id(self.scenario, self.difficulty_value(), self.freedoom)
+            return vizdoom_env.engine_id(self.scenario, self.difficulty_value(), self.freedoom, self.resize)
         return registry.get(self.scenario).gym_id
 
     def name(self) -> str:

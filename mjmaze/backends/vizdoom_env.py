@@ -11,7 +11,8 @@ and ``multi_env.py`` of github.com/edbeeching/3d_control_deep_rl (MIT licence):
 - the maze's released ``.cfg``/``.wad`` (its rewards, its 2,100-tic timeout,
   its items and their scripts), at 320x180, the ``--limit_actions`` buttons
   (left, right, forward, forward+left, forward+right) held 4 tics a step,
-  head-bob on, the frame resized to 112x64 with ``cv2.INTER_AREA``;
+  head-bob on, the frame resized to 112x64 as the released call resized it
+  (bilinear: :data:`RESIZES`);
 - the released training reward: the cfg's, and +1 whenever health rises where
   the cfg reports health (Two-colour: a right item), as ``_check_health``
   paid it (mjmaze pays it on both splits, and so does this env);
@@ -183,12 +184,26 @@ def released_game(cfg: str | os.PathLike, seed: int = 0, wad: str | None = None,
     return game
 
 
-def frame(game) -> np.ndarray:
-    """The observation: the 320x180 screen resized to 112x64 with ``cv2.INTER_AREA``, ``(64, 112, 3)`` uint8 RGB."""
+#: How the 320x180 screen becomes a 112x64 frame, by OpenCV's interpolation flag. ``"released"``: as the
+#: released env did it. ``doom_environment.py`` calls ``resize(obs, (112, 64), cv2.INTER_AREA)``, but
+#: OpenCV's Python signature is ``resize(src, dsize[, dst[, fx[, fy[, interpolation]]]])``: a third
+#: positional argument is ``dst``, which it ignores, so the paper's agents saw OpenCV's default, bilinear
+#: (a mean 32 grey levels from INTER_AREA on a random screen). ``"area"``: ``cv2.INTER_AREA``, what the call
+#: meant, and what mjmaze's ViZDoom runs and measurements used until 2026-11-29 (docs/scenarios.md).
+RESIZES = {"released": "INTER_LINEAR", "area": "INTER_AREA"}
+
+
+def frame(game, resize: str = "released") -> np.ndarray:
+    """The observation: the 320x180 screen resized to 112x64 (:data:`RESIZES`), ``(64, 112, 3)`` uint8 RGB."""
     import cv2
 
     screen = game.get_state().screen_buffer  # CRCGCB (the cfg): (3, 180, 320)
-    return cv2.resize(screen.transpose(1, 2, 0), FRAME_SIZE, interpolation=cv2.INTER_AREA)
+    return cv2.resize(screen.transpose(1, 2, 0), FRAME_SIZE, interpolation=getattr(cv2, RESIZES[resize]))
+
+
+def check_resize(resize: str) -> None:
+    if resize not in RESIZES:
+        raise ValueError(f"resize must be one of {tuple(RESIZES)}, got {resize!r}")
 
 
 def episode_metrics(scenario: str, rewards: Sequence[float], steps: int, difficulty: int,
@@ -231,10 +246,11 @@ class ReleasedMazeEnv(gym.Env):
     metadata = {"render_modes": ["rgb_array"]}
 
     def __init__(self, scenario: str, difficulty: int, folder: str, mazes: Sequence[int], first: int = 0,
-                 wad: str | None = None, head_bob: bool = True, health_reward: bool = True):
+                 wad: str | None = None, head_bob: bool = True, health_reward: bool = True, resize: str = "released"):
+        check_resize(resize)
         self.scenario, self.difficulty, self.folder = scenario, int(difficulty), pathlib.Path(folder)
         self.mazes, self.position = list(mazes), int(first)
-        self.wad, self.head_bob, self.health_reward = wad, head_bob, health_reward
+        self.wad, self.head_bob, self.health_reward, self.resize = wad, head_bob, health_reward, resize
         self.observation_space = gym.spaces.Box(0, 255, (FRAME_SIZE[1], FRAME_SIZE[0], 3), np.uint8)
         self.action_space = gym.spaces.Discrete(len(LIMITED_ACTIONS))
         self._games: dict[int, object] = {}
@@ -271,7 +287,7 @@ class ReleasedMazeEnv(gym.Env):
         health = _vizdoom().GameVariable.HEALTH
         self._health_variable = health if health in self._game.get_available_game_variables() else None
         self._rewards, self._health = [], self._health_now()
-        return frame(self._game), {}
+        return frame(self._game, self.resize), {}
 
     def step(self, action):
         game = self._game
@@ -282,7 +298,7 @@ class ReleasedMazeEnv(gym.Env):
         self._health = health
         self._rewards.append(reward)
         if not game.is_episode_finished():
-            return frame(game), reward, False, False, {}
+            return frame(game, self.resize), reward, False, False, {}
         timed_out = game.get_episode_time() >= game.get_episode_timeout() and not game.is_player_dead()
         info = {
             "episode_return": float(sum(self._rewards)),
@@ -326,13 +342,13 @@ def env_mazes(num_envs: int, num_configs: int, order: str) -> list[tuple[list[in
 def make_vector_env(num_envs: int, scenario: str, difficulty: int | None = None, split: str = "train",
                     released_dir: str | os.PathLike | None = None, num_configs: int | None = None,
                     order: str = "released", freedoom: str = "paper", head_bob: bool = True,
-                    autoreset_mode: str = "same_step") -> gym.vector.AsyncVectorEnv:
+                    autoreset_mode: str = "same_step", resize: str = "released") -> gym.vector.AsyncVectorEnv:
     """``num_envs`` envs of a released setting in worker processes, behind gymnasium's vector API.
 
     ``difficulty`` None is the scenario's default; ``num_configs`` the mazes
     of ``split`` to play (default: the released command's 256 train / 64
     test); ``order`` see :func:`env_mazes`; ``freedoom`` see
-    :func:`freedoom_path`. Observations are numpy ``(num_envs, 64, 112, 3)``
+    :func:`freedoom_path`; ``resize`` :data:`RESIZES`. Observations are numpy ``(num_envs, 64, 112, 3)``
     uint8, as :class:`mjmaze.backends.vector.MazeVectorEnv` gives them.
     """
     _vizdoom()
@@ -345,9 +361,11 @@ def make_vector_env(num_envs: int, scenario: str, difficulty: int | None = None,
     modes = {"same_step": gym.vector.AutoresetMode.SAME_STEP, "next_step": gym.vector.AutoresetMode.NEXT_STEP}
     if autoreset_mode not in modes:
         raise ValueError(f"autoreset_mode must be one of {tuple(modes)}, got {autoreset_mode!r}")
+    check_resize(resize)
     wad = freedoom_path(freedoom)
     makers = [
-        functools.partial(ReleasedMazeEnv, scenario, difficulty, str(folder), mazes, first, wad, head_bob)
+        functools.partial(ReleasedMazeEnv, scenario, difficulty, str(folder), mazes, first, wad, head_bob,
+                          resize=resize)
         for mazes, first in env_mazes(num_envs, num_configs, order)
     ]
     # Spawned workers: the parent may hold torch's threads, which a fork would copy half-made.
@@ -372,6 +390,7 @@ class ReleasedVectorEnv(gym.vector.AsyncVectorEnv):
         super().close_extras(timeout, terminate)
 
 
-def engine_id(scenario: str, difficulty: int, freedoom: str = "paper") -> str:
-    """What a run on this engine played, as a run's ``env_id`` names mjmaze's version."""
-    return f"vizdoom:{RELEASED_FOLDERS[scenario]}/{difficulty}@{freedoom}"
+def engine_id(scenario: str, difficulty: int, freedoom: str = "paper", resize: str = "released") -> str:
+    """What a run on this engine played, as a run's ``env_id`` names mjmaze's version (``+area``: frames
+    resized with INTER_AREA, :data:`RESIZES`)."""
+    return f"vizdoom:{RELEASED_FOLDERS[scenario]}/{difficulty}@{freedoom}" + ("" if resize == "released" else f"+{resize}")
