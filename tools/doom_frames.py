@@ -128,8 +128,9 @@ def write_wad(path: pathlib.Path, text: str, behavior: bytes | None = None) -> N
 
 
 def area_resize(frame: np.ndarray, size: tuple[int, int] = SIZE) -> np.ndarray:
-    """``frame`` resized as the released env resizes it (``cv2.INTER_AREA``: each output pixel the
-    mean over its footprint, source pixels split by their overlap), as float64.
+    """``frame`` resized with ``cv2.INTER_AREA`` (each output pixel the mean over its footprint, source
+    pixels split by their overlap), as float64: what the released env's call meant, and what mjmaze's
+    look was measured against; the call itself resized bilinearly (docs/scenarios.md, open).
 
     cv2 rather than a hand-made binning: assigning each source pixel wholly to one output pixel
     weights pixels unevenly at this 2.86x2.81 ratio and misstated a small item's contrast by 10-25%.

@@ -262,9 +262,10 @@ def textures(sprite: Sprite, unit_depth: float) -> tuple[np.ndarray, np.ndarray]
     channel needs beyond ``AMBIENT``.
 
     The picture is averaged, at each pixel, over the opaque pixels of the
-    bin's square (``BOX_SIZES``) around it, as the released frames average a
-    sprite that 320x180 pixels drew into 112x64 (``cv2.INTER_AREA``: a frame
-    pixel is the mean of the sprite under it): :class:`mjmaze.drawing.look.SpriteView`
+    bin's square (``BOX_SIZES``) around it, as ``cv2.INTER_AREA`` averages a
+    sprite that 320x180 pixels drew into 112x64 (a frame pixel is the mean of
+    the sprite under it; what the released call meant, though it resized
+    bilinearly: docs/scenarios.md, open): :class:`mjmaze.drawing.look.SpriteView`
     shows each sprite its depth's bin, and GL's nearest texel is then that mean.
     Transparent texels take the frame's mean colour (only the mesh's edges could sample them).
     """
