@@ -4,6 +4,7 @@ import json
 import pathlib
 
 import numpy as np
+import pytest
 
 from mjmaze.train import engines
 
@@ -71,3 +72,17 @@ def test_the_table_gives_each_engines_greedy_test_value_at_the_papers_step(tmp_p
     engines.add([run], data_file)
     rows = engines.table(engines.read_data(data_file)).splitlines()[2:]
     assert rows[0].endswith("| – / 470 |") and rows[1].endswith("| – / 520 |") and rows[2].endswith("| – / – |")
+
+
+def test_runs_of_one_engine_under_two_env_ids_are_kept_apart_and_not_averaged(tmp_path):
+    # ViZDoom's frames resized as released and with INTER_AREA are two envs: both records stay in the file,
+    # and drawing them as one curve's seeds is refused.
+    data_file = tmp_path / "engines.json"
+    area = write_run(tmp_path / "area", "vizdoom", 0, np.full(8, 440.0))
+    released = write_run(tmp_path / "released", "vizdoom", 0, np.full(8, 450.0))
+    config = json.loads((released / "config.json").read_text())
+    (released / "config.json").write_text(json.dumps({**config, "resize": "released"}))
+    data = engines.add([area, released], data_file)
+    assert sorted(r["env_id"] for r in data["runs"]) == ["vizdoom:two_color/1@paper", "vizdoom:two_color/1@paper+area"]
+    with pytest.raises(ValueError, match="keep one env id"):
+        engines.table(data)

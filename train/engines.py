@@ -104,12 +104,12 @@ def read_data(path: pathlib.Path = DATA) -> dict:
 
 
 def add(run_dirs: list[pathlib.Path], path: pathlib.Path = DATA) -> dict:
-    """Puts each run's record into the data file, replacing the record of the same setting, engine and seed."""
+    """Puts each run's record into the data file, replacing the record of the same setting, env id and seed."""
     data = read_data(path)
     for run_dir in run_dirs:
         record = run_record(pathlib.Path(run_dir))
-        key = (record["setting"], record["engine"], record["seed"])
-        data["runs"] = [r for r in data["runs"] if (r["setting"], r["engine"], r["seed"]) != key] + [record]
+        key = (record["setting"], record["env_id"], record["seed"])
+        data["runs"] = [r for r in data["runs"] if (r["setting"], r["env_id"], r["seed"]) != key] + [record]
     data["runs"].sort(key=lambda r: (r["setting"], r["engine"], r["seed"]))
     files.atomic_write_json(path, data)
     return data
@@ -160,6 +160,16 @@ def greedy_test_at(records: list[dict], step: int) -> str:
     return f"{np.mean(values):.4g}" if values else "–"
 
 
+def engine_records(data: dict, setting: str, engine: str) -> list[dict]:
+    """One engine's records of a setting, its seeds; records of one engine under two env ids (ViZDoom's
+    frames resized two ways, mjmaze's scenario at two versions) are not seeds of one curve: an error."""
+    records = [r for r in data["runs"] if r["setting"] == setting and r["engine"] == engine]
+    ids = sorted({r["env_id"] for r in records})
+    if len(ids) > 1:
+        raise ValueError(f"{setting} on {engine} holds runs of {ids}: keep one env id in {DATA.name} per engine")
+    return records
+
+
 def table(data: dict) -> str:
     """The markdown table: per setting and paper level, the observations each engine's seeds needed to reach
     it in training episodes, their ratio, and each engine's greedy test value at the paper's step (the
@@ -170,8 +180,7 @@ def table(data: dict) -> str:
     for setting in sorted({r["setting"] for r in data["runs"]}):
         scenario = setting.rpartition("_")[0]
         units, digits = published.curve_units(scenario), published.of(scenario).metric_digits
-        by_engine = {engine: [r for r in data["runs"] if r["setting"] == setting and r["engine"] == engine]
-                     for engine in ENGINE_NAMES}
+        by_engine = {engine: engine_records(data, setting, engine) for engine in ENGINE_NAMES}
         for step, level in paper_levels(setting):
             cells, reached = [], {}
             for engine, records in by_engine.items():
@@ -213,7 +222,7 @@ def figure(data: dict, setting: str):
     ax = fig.subplots()
     reach = 0
     for colour, (engine, name) in zip(("C0", "C1"), ENGINE_NAMES.items()):
-        records = [r for r in data["runs"] if r["setting"] == setting and r["engine"] == engine]
+        records = engine_records(data, setting, engine)
         if not records:
             continue
         for r in records:
