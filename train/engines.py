@@ -29,6 +29,7 @@ from mjmaze import files
 from mjmaze.game import registry
 
 from . import checkpoint, curves, published
+from .settings import Args
 from .analysis import save_figure
 
 DATA = pathlib.Path("docs/data/engines.json")
@@ -60,11 +61,7 @@ def env_id(config: dict) -> str | None:
     ``resize`` existed resized with INTER_AREA, which its saved id does not say)."""
     if checkpoint.setting_of(config, "engine") != "vizdoom":
         return config.get("env_id")
-    from mjmaze.backends import vizdoom_env
-
-    difficulty = config[registry.get(config["scenario"]).difficulty]
-    return vizdoom_env.engine_id(config["scenario"], difficulty, checkpoint.setting_of(config, "freedoom"),
-                                 checkpoint.setting_of(config, "resize"))
+    return Args.from_config(config).env_id()
 
 
 def run_record(run_dir: pathlib.Path) -> dict:

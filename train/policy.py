@@ -53,10 +53,7 @@ def load_run(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | 
     config_file = run_dir / "config.json"
     if not config_file.exists():
         raise FileNotFoundError(f"{run_dir} is not a training run (no config.json)")
-    # A run saved before a setting existed ran without it (checkpoint.MISSING_MEANS).
-    saved = {**checkpoint.MISSING_MEANS, **json.loads(config_file.read_text())}
-    # Keys that are not settings (env_id: what the run was trained on) stay in config.json.
-    args = Args(**{k: v for k, v in saved.items() if k in {f.name for f in dataclasses.fields(Args)}})
+    args = Args.from_config(json.loads(config_file.read_text()))
     if checkpoint_path is None:
         found = checkpoint.checkpoints(run_dir / "checkpoints")
         if not found:

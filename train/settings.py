@@ -144,6 +144,15 @@ class _RunSettings:
         value = getattr(self, registry.get(self.scenario).difficulty, None)
         return suite.default_difficulty(self.scenario) if value is None else value
 
+    @classmethod
+    def from_config(cls, config: dict) -> Args:
+        """The settings a run's ``config.json`` saved; a setting it predates is what it ran with
+        (:data:`checkpoint.MISSING_MEANS`), and keys that are no setting (its ``env_id``) are left out."""
+        from . import checkpoint
+
+        saved = {**checkpoint.MISSING_MEANS, **config}
+        return cls(**{k: v for k, v in saved.items() if k in {f.name for f in dataclasses.fields(cls)}})
+
     def env_id(self) -> str:
         """What the envs play: mjmaze's versioned gym id, or the released setting on ViZDoom."""
         if self.engine == "vizdoom":

@@ -53,6 +53,7 @@ import numpy as np
 
 from mjmaze import files
 from mjmaze.backends import suite
+from mjmaze.game import core
 from mjmaze.game.doom import TICS_PER_STEP
 
 # The released --limit_actions buttons, in its order (TURN_LEFT, TURN_RIGHT, MOVE_FORWARD, MOVE_BACKWARD):
@@ -202,8 +203,7 @@ def frame(game, resize: str = "released") -> np.ndarray:
 
 
 def check_resize(resize: str) -> None:
-    if resize not in RESIZES:
-        raise ValueError(f"resize must be one of {tuple(RESIZES)}, got {resize!r}")
+    core.check_choice("resize", resize, tuple(RESIZES))
 
 
 def episode_metrics(scenario: str, rewards: Sequence[float], steps: int, difficulty: int,
