@@ -97,6 +97,42 @@ def test_the_rollouts_own_graph_gives_the_gradients_of_a_recomputed_unroll():
         assert torch.allclose(a, b, rtol=1e-4, atol=1e-6)
 
 
+class _ScriptedEnvs:
+    """Three envs whose episodes end on a script, each with its own final info; the others' fields hold NaN."""
+
+    ends = {1: {0: 10.0}, 2: {1: 20.0, 2: 30.0}, 3: {0: 40.0}}  # step -> {env: episode_return}
+
+    def __init__(self):
+        self.t = 0
+
+    def reset(self, seed=None):
+        return torch.zeros(3, 64, 112, 3, dtype=torch.uint8).numpy(), {}
+
+    def step(self, actions):
+        ended = self.ends.get(self.t, {})
+        self.t += 1
+        terminated = torch.tensor([i in ended for i in range(3)]).numpy()
+        infos = {}
+        if ended:
+            returns = torch.tensor([ended.get(i, math.nan) for i in range(3)], dtype=torch.float64).numpy()
+            infos = {"final_info": {"episode_return": returns, "success": returns / 10, "_episode_return": terminated},
+                     "_final_info": terminated}
+        obs = torch.zeros(3, 64, 112, 3, dtype=torch.uint8).numpy()
+        return obs, torch.zeros(3).numpy(), terminated, terminated & False, infos
+
+
+def test_the_logged_figures_are_the_means_of_the_episodes_that_ended_in_the_rollout(tmp_path):
+    # Read once per rollout (no host read per step on a GPU), and still each ended episode counted once.
+    args = tiny(tmp_path, num_envs=3, num_steps=5)
+    learner = a2c._Learner(args, Agent(5), None, torch.device("cpu"))
+    envs = _ScriptedEnvs()
+    learner.restart(envs, seed=0)
+    episodes, means = learner.rollout(envs).episodes.read()
+    assert episodes == 4
+    assert means == pytest.approx({"episode_return": 25.0, "success": 2.5})
+    assert learner.rollout(envs).episodes.read() == (0, {})  # no episode ended
+
+
 def test_two_update_smoke_run_writes_a_run_folder(tmp_path):
     run = a2c.train(tiny(tmp_path, total_steps=32))
     config = json.loads((run / "config.json").read_text())

@@ -29,7 +29,6 @@ import signal
 import sys
 import time
 
-import numpy as np
 import torch
 import tyro
 from torch.nn import functional as F
@@ -139,6 +138,39 @@ def training_envs(args: Args, device: torch.device) -> functools.partial:
     )
 
 
+class _Episodes:
+    """The episodes that ended in a rollout: how many, and each final-info field's sum over them.
+
+    Kept where the envs make them (the GPU with the Warp backend) and read
+    once per rollout (:meth:`read`): reading the ended envs' infos back every
+    step would make the host wait for the device every step.
+    """
+
+    def __init__(self) -> None:
+        self.count: torch.Tensor | None = None
+        self.sums: dict[str, torch.Tensor] = {}
+
+    def add(self, ended: torch.Tensor, final_info: dict) -> None:
+        """Adds the envs that ``ended`` (a bool mask) this step, with their ``final_info`` (one array per field)."""
+        count = ended.sum()
+        self.count = count if self.count is None else self.count + count
+        for name, values in final_info.items():
+            if name.startswith("_"):  # gymnasium's masks; ``ended`` is the mask
+                continue
+            values = torch.as_tensor(values, device=ended.device).to(torch.float64)
+            total = torch.where(ended, values, 0.0).sum()  # where, not a product: a field may hold NaN elsewhere
+            self.sums[name] = total if name not in self.sums else self.sums[name] + total
+
+    def read(self) -> tuple[int, dict[str, float]]:
+        """``(episodes, {field: mean over them})``, one copy to the host."""
+        if self.count is None:
+            return 0, {}
+        names = list(self.sums)
+        values = torch.stack([self.count.to(torch.float64), *(self.sums[n] for n in names)]).cpu().tolist()
+        count = int(values[0])
+        return count, ({name: total / count for name, total in zip(names, values[1:])} if count else {})
+
+
 @dataclasses.dataclass
 class _Rollout:
     """One update's ``T`` steps of ``n`` envs: what the loss needs, and the episodes that ended."""
@@ -148,7 +180,7 @@ class _Rollout:
     dones: torch.Tensor
     logits: list = dataclasses.field(default_factory=list)  #: each step's, with its graph (see :meth:`_Learner.rollout`)
     values: list = dataclasses.field(default_factory=list)
-    finished: list = dataclasses.field(default_factory=list)  #: final infos of the episodes that ended
+    episodes: _Episodes = dataclasses.field(default_factory=_Episodes)  #: the episodes that ended
     env_seconds: float = 0.0  #: of the rollout, in ``envs.step``
 
 
@@ -198,10 +230,7 @@ class _Learner:
                 done.dones[t] = ended
                 self.episode_starts = ended
                 if "final_info" in infos:
-                    # One copy to the host per field (the Warp backend's are on the GPU), not one per value.
-                    final = {k: torch.as_tensor(v).cpu() for k, v in infos["final_info"].items() if not k.startswith("_")}
-                    for i in torch.nonzero(ended).flatten().tolist():
-                        done.finished.append({k: v[i].item() for k, v in final.items()})
+                    done.episodes.add(ended, infos["final_info"])
         except WorkerError:
             # Nothing holds the cut rollout's graph (~90 KB a frame) while the envs are rebuilt.
             done.logits.clear()
@@ -248,14 +277,15 @@ class _RunLog:
         self.metrics_file = open(run_dir / "metrics.jsonl", "a")
         self.bar = tqdm(total=args.total_steps, initial=step, unit="step", disable=not args.progress, dynamic_ncols=True)
 
-    def write(self, record: dict, finished: list[dict], steps: int) -> None:
-        """Logs one update's ``record``, with the means of the ``finished`` episodes; ``steps`` observations."""
+    def write(self, record: dict, means: dict[str, float], steps: int) -> None:
+        """Logs one update's ``record``, with the ``means`` of its ended episodes' final infos; ``steps`` observations."""
         metric, step = self.metric, record["step"]
+        finished = bool(means)
         if finished:
-            record["episode_return"] = float(np.mean([e["episode_return"] for e in finished]))
-            record[metric] = float(np.mean([e[metric] for e in finished])) * self.scale
+            record["episode_return"] = means["episode_return"]
+            record[metric] = means[metric] * self.scale
             if self.curve_field:
-                record[self.curve_field] = float(np.mean([e[self.curve_field] for e in finished])) * self.curve_scale
+                record[self.curve_field] = means[self.curve_field] * self.curve_scale
         self.metrics_file.write(json.dumps(record) + "\n")
         self.metrics_file.flush()
         for key in ("policy_loss", "value_loss", "entropy"):
@@ -310,6 +340,7 @@ def _loop(args, make_envs, envs, agent, optimizer, device, run_dir, step, update
             failures = 0
             update_started = time.perf_counter()
             losses = learner.update(rollout)
+            episodes, means = rollout.episodes.read()
             step += batch
             update += 1
             now = time.perf_counter()
@@ -320,8 +351,8 @@ def _loop(args, make_envs, envs, agent, optimizer, device, run_dir, step, update
                 "update_seconds": now - update_started,
                 "policy_loss": losses["policy"].item(), "value_loss": losses["value"].item(),
                 "entropy": losses["entropy"].item(), "grad_norm": float(losses["grad_norm"]),
-                "episodes": len(rollout.finished), "env_rebuilds": rebuilds,
-            }, rollout.finished, batch)
+                "episodes": episodes, "env_rebuilds": rebuilds,
+            }, means, batch)
             if step >= next_checkpoint:
                 _save(args, agent, optimizer, step, update, run_dir)
                 next_checkpoint += args.checkpoint_every
