@@ -16,7 +16,8 @@ its figures then mean nothing. Sections (``--only`` picks some):
   env       MazeBatchEnv obs/s, rendering on and off, at 1,024 .. 8,192 worlds,
             Warp launches per step, device memory per world (bench/warp.py)
   train     A2C training obs/s, `python -m mjmaze.train.a2c --backend warp`,
-            at 1,024 and 4,096 envs (bench/warp.py)
+            at 1,024 and 4,096 envs (bench/warp.py); the host's waits for the
+            device in one rollout (torch's sync debug mode)
   cpu       the CPU backend (MazeVectorEnv) with one process per core, drawing
             with EGL (on NVIDIA's driver where there is one), beside the raw
             loop and ViZDoom (bench/multiproc.py's sides, alternating); a
@@ -261,14 +262,57 @@ def _graph_training(device: str, quick: bool) -> dict:
 
 
 def training(device: str, quick: bool) -> dict:
-    """A2C training obs/s on the Warp backend (bench/warp.py's ``bench_training``)."""
+    """A2C training obs/s on the Warp backend (bench/warp.py's ``bench_training``), and the host waits in a rollout."""
     bench = _sibling("warp")
-    results = {}
+    results = {"rollout_syncs": rollout_syncs(device, quick)}
     for worlds, updates in (((8, 3),) if quick else ((1024, 12), (4096, 8))):
         rate = bench.bench_training(worlds, device, updates)
         results[str(worlds)] = rate
         print(f"  train  labyrinth 9  {worlds:5d} envs: {rate:10.0f} obs/s", flush=True)
     return results
+
+
+def rollout_syncs(device: str, quick: bool) -> dict:
+    """How often one A2C rollout on the Warp backend makes the host wait for the device (torch's sync debug mode
+    counts them): a wait per step keeps the card idle while Python catches up."""
+    import warnings
+
+    import torch
+    from mjmaze.train import a2c
+    from mjmaze.train import settings as run_settings
+    from mjmaze.train.model import Agent
+
+    from mjmaze.backends.warp import MazeBatchEnv
+
+    worlds, steps = (8, 16) if quick else (1024, 32)
+    args = run_settings.Args(scenario="labyrinth", size=9, backend="warp", device=device, num_envs=worlds,
+                             num_steps=steps, progress=False)
+    envs = MazeBatchEnv(worlds, "labyrinth", device=device, size=9, autoreset_mode="same_step")
+    learner = a2c._Learner(args, Agent(envs.single_action_space.n).to(device), None, torch.device(device))
+    learner.restart(envs, seed=0)
+    learner.rollout(envs)  # warm-up: first launches, allocations (its graph freed here)
+    learner.hidden = learner.hidden.detach()
+    cuda = device.startswith("cuda")  # the rollout runs on Warp's CPU device too (--quick), uncounted
+    if cuda:
+        torch.cuda.synchronize(device)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        if cuda:
+            torch.cuda.set_sync_debug_mode("warn")
+        try:
+            episodes, _ = learner.rollout(envs).episodes.read()
+        finally:
+            if cuda:
+                torch.cuda.set_sync_debug_mode("default")
+    envs.close()
+    if not cuda:
+        print(f"  train  host waits in one rollout: counted on a CUDA device only ({episodes} episodes ended)", flush=True)
+        return {"skipped": "counted on a CUDA device only"}
+    syncs = [w for w in caught if "synchroniz" in str(w.message)]
+    print(f"  train  host waits in one rollout ({worlds} envs x {steps} steps, episodes read once): {len(syncs)}",
+          flush=True)
+    return {"worlds": worlds, "steps": steps, "syncs": len(syncs),
+            "kinds": sorted({str(w.message).splitlines()[0][:80] for w in syncs})}
 
 
 def _gl_renderer() -> str:
