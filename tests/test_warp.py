@@ -243,7 +243,7 @@ def test_a_step_can_be_captured_as_cuda_graphs(scenario, mode, monkeypatch):
     batch.reset(seed=SEED)
     actions = torch.tensor([2, 0, 1])
     batch.step(actions)  # a CUDA graph's warm-up: the step's constants made once
-    step_in_place, run_warp = batch._step_in_place, batch._run_warp
+    step_in_place, run_warp = batch._stepper._step, batch._run_warp
     launches = {"in Warp's runs": 0, "elsewhere": 0}
     in_warp = False
 
@@ -266,7 +266,7 @@ def test_a_step_can_be_captured_as_cuda_graphs(scenario, mode, monkeypatch):
             return launch(*args, **kwargs)
         return counting
 
-    batch._step_in_place, batch._run_warp = guarded_step, guarded_warp
+    batch._stepper._step, batch._run_warp = guarded_step, guarded_warp
     for name in ("launch", "launch_tiled"):  # MuJoCo Warp calls them by attribute
         monkeypatch.setattr(mjwarp.wp, name, counted(getattr(mjwarp.wp, name)))
     ends = 0
@@ -283,6 +283,107 @@ def test_a_step_can_be_captured_as_cuda_graphs(scenario, mode, monkeypatch):
         batch._obs[..., [2, 1, 0]]  # an index sent from the host,
     with pytest.raises(AssertionError, match="torch op"):
         guarded_warp(lambda: batch._obs.float())  # and torch among Warp's calls
+
+
+def _carried_tensors(batch) -> dict[str, tuple[int, int]]:
+    """Every tensor a step can carry over to the next: the env's, its frame pipeline's, the rule state's
+    (name -> the tensor's identity and the address of its storage)."""
+    found = {}
+    for owner, fields in (("env", vars(batch)), ("pipeline", vars(batch._pipeline)), ("state", batch.state)):
+        for name, value in fields.items():
+            if isinstance(value, torch.Tensor):
+                found[f"{owner}.{name}"] = (id(value), value.untyped_storage().data_ptr())
+    return found
+
+
+@pytest.mark.parametrize("scenario", ["two_colour", "k_item"])
+def test_every_tensor_a_step_carries_over_keeps_its_storage(scenario):
+    # A CUDA graph replays the addresses it captured: a step that rebinds what it carries over
+    # (self._x = torch.where(...)) would replay on the old tensor, silently. Checked on Warp's CPU device,
+    # over steps where worlds restart (same-step autoreset) and where none does.
+    batch = mjwarp.MazeBatchEnv(3, scenario, device="cpu", autoreset_mode="same_step", restart_by_index=False,
+                                **SETTINGS[scenario])
+    batch.reset(seed=SEED)
+    actions = torch.tensor([2, 0, 1])
+    batch.step(actions)  # the step's constants made once, as in a graph's warm-up
+    before = _carried_tensors(batch)
+    assert len(before) > 20
+    for step in range(4):
+        if step % 2 == 0:
+            batch.state["steps"][0] = core.EPISODE_STEPS - 1  # env 0 restarts on this step
+        batch.step(actions)
+        after = _carried_tensors(batch)
+        assert after.keys() == before.keys()
+        moved = sorted(name for name in before if after[name] != before[name])
+        assert not moved, f"step {step} rebound or reallocated {moved}"
+    batch.close()
+
+
+class _ReplayedGraphs:
+    """Stands in for _StepGraphs on the CPU: a replay runs the step and writes its results into the tensors
+    the capture returned, as a CUDA graph does. (A CUDA capture runs nothing; this one runs the step to get
+    its outputs, so the first replay after it is already done.)"""
+
+    captures = 0
+
+    def capture(self, step):
+        _ReplayedGraphs.captures += 1
+        self._step, self._captured = step, True
+        self._outputs = step()
+        return self._outputs
+
+    def warp(self, calls):
+        calls()
+
+    def replay(self):
+        if self._captured:
+            self._captured = False
+            return
+
+        def write(kept, new):
+            if isinstance(kept, dict):
+                for name in kept:
+                    write(kept[name], new[name])
+            elif isinstance(kept, tuple):
+                for a, b in zip(kept, new):
+                    write(a, b)
+            else:
+                kept.copy_(new)
+        write(self._outputs, self._step())
+
+
+def test_the_graphed_step_warms_up_captures_once_replays_and_hands_over_copies():
+    batch = mjwarp.MazeBatchEnv(2, "labyrinth", device="cpu", autoreset_mode="same_step", size=5)
+    launched = mjwarp.MazeBatchEnv(2, "labyrinth", device="cpu", autoreset_mode="same_step", size=5)
+    _ReplayedGraphs.captures = 0
+    batch._stepper = mjwarp._GraphedStep(batch._step_in_place, batch._streams, 2, batch.device, _ReplayedGraphs)
+    for env in (batch, launched):
+        env.reset(seed=SEED)
+    kept = []
+    for step, action in enumerate([2, 2, 0, 2, 1, 2]):
+        actions = torch.tensor([action, 2])
+        graphed, plain = batch.step(actions), launched.step(actions)
+        assert _ReplayedGraphs.captures == (0 if step < mjwarp._EAGER_STEPS else 1)
+        assert torch.equal(graphed[0], plain[0]) and torch.equal(graphed[1], plain[1])
+        assert torch.equal(graphed[4]["x"], plain[4]["x"])
+        kept.append((graphed[1].clone(), graphed[4]["x"].clone(), graphed))
+    for reward, x, returned in kept:  # a later replay did not write into what an earlier step returned
+        assert torch.equal(returned[1], reward) and torch.equal(returned[4]["x"], x)
+
+
+def test_a_failed_capture_is_one_clear_error_on_every_later_step():
+    class Failing(_ReplayedGraphs):
+        def capture(self, step):
+            raise RuntimeError("operation not permitted when stream is capturing")
+
+    batch = mjwarp.MazeBatchEnv(2, "labyrinth", device="cpu", size=5)
+    batch._stepper = mjwarp._GraphedStep(batch._step_in_place, batch._streams, 2, batch.device, Failing)
+    batch.reset(seed=SEED)
+    for _ in range(mjwarp._EAGER_STEPS):
+        batch.step(torch.tensor([2, 2]))
+    for _ in range(2):
+        with pytest.raises(RuntimeError, match="capturing the step failed .* cuda_graph=False"):
+            batch.step(torch.tensor([2, 2]))
 
 
 @pytest.mark.parametrize("by_index", [False, True])

@@ -254,12 +254,11 @@ class MazeBatchEnv(batch.BatchEnv):
         self._graph_stream = torch.cuda.Stream(dev) if cuda_graph else None
         self._stream = (wp.stream_from_torch(self._graph_stream or torch.cuda.current_stream(dev))
                         if dev.type == "cuda" else None)
-        self._graphs: _StepGraphs | None = None  # the step's graphs, once captured
-        self._capturing: _StepGraphs | None = None  # the graphs being captured, while they are
-        self._graph_actions = torch.zeros(self.num_envs, dtype=torch.int64, device=dev)
-        self._graph_outputs: tuple | None = None
-        self._graph_error: RuntimeError | None = None  # why capturing failed, once it has
-        self._eager_steps = 0
+        if cuda_graph:
+            self._stepper = _GraphedStep(self._step_in_place, self._streams, self.num_envs, dev,
+                                         lambda: _StepGraphs(self._stream, dev))
+        else:
+            self._stepper = _LaunchedStep(self._step_in_place, self._streams)
 
     def _allocate_state(self) -> None:
         """The per-world buffers a step writes in place (a captured graph replays on their storage)."""
@@ -314,24 +313,8 @@ class MazeBatchEnv(batch.BatchEnv):
         actions = torch.as_tensor(actions, device=self.device).long()
         if self.state is None:
             raise RuntimeError("call reset() before step()")
-        if self._graph_stream is None:
-            with self._streams():
-                reward, terminated, truncated, infos = self._step_in_place(actions)
-            return self._obs.clone(), reward, terminated, truncated, infos
-        if self._graph_error is not None:
-            raise self._graph_error
-        with self._streams():
-            self._graph_actions.copy_(actions)
-            if self._graphs is None and self._eager_steps < _EAGER_STEPS:
-                self._eager_steps += 1
-                outputs = self._step_in_place(self._graph_actions)
-            else:
-                if self._graphs is None:
-                    self._capture_step()
-                self._graphs.replay()
-                outputs = self._graph_outputs
-        # Copies on the caller's stream: a graph's outputs are overwritten by its next replay.
-        return (self._obs.clone(), *_copies(outputs))
+        reward, terminated, truncated, infos = self._stepper(actions)
+        return self._obs.clone(), reward, terminated, truncated, infos
 
     def _step_in_place(self, actions: torch.Tensor) -> tuple:
         """A step of every env (:func:`mjmaze.backends.batch.autoreset_step`): ``(reward, terminated, truncated, infos)``.
@@ -347,37 +330,13 @@ class MazeBatchEnv(batch.BatchEnv):
         infos.update(final or {})
         return reward.float(), terminated, truncated, infos
 
-    def _capture_step(self) -> None:
-        """Captures :meth:`_step_in_place` of :attr:`_graph_actions` as :class:`_StepGraphs` (capturing runs nothing).
-
-        Python's cyclic garbage collector is held off meanwhile: a tensor or a
-        Warp array it freed would be freed on a stream one library captures
-        unknown to the other. A failed capture is raised on every later step.
-        """
-        torch.cuda.synchronize(self.device)
-        gc.collect()
-        collecting = gc.isenabled()
-        gc.disable()
-        graphs = self._capturing = _StepGraphs(self._stream, self.device)
-        try:
-            self._graph_outputs = graphs.capture(lambda: self._step_in_place(self._graph_actions))
-        except Exception as error:
-            self._graph_error = RuntimeError(
-                f"cuda_graph=True: capturing the step failed ({type(error).__name__}: {error}); this env stepped no "
-                "further: make a new one with cuda_graph=False")
-            raise self._graph_error from error
-        finally:
-            self._capturing = None
-            if collecting:
-                gc.enable()
-        self._graphs = graphs
-
     def _run_warp(self, calls: Callable[[], None]) -> None:
         """Runs a run of MuJoCo Warp's calls; while the step is being captured, as a Warp graph of its own."""
-        if self._capturing is None:
+        capturing = self._stepper.capturing
+        if capturing is None:
             calls()
         else:
-            self._capturing.warp(calls)
+            capturing.warp(calls)
 
     # -- the steps of batch.autoreset_step (every env, masks: no host reads) ---
 
@@ -410,7 +369,7 @@ class MazeBatchEnv(batch.BatchEnv):
 
     def close_extras(self, **kwargs: Any) -> None:
         self.state = None
-        self._graphs = self._graph_outputs = None
+        self._stepper.close()
 
     # -- what the env does per step ------------------------------------------
 
@@ -581,6 +540,87 @@ class MazeBatchEnv(batch.BatchEnv):
 
     def __repr__(self) -> str:
         return f"MazeBatchEnv({self.scenario!r}, num_envs={self.num_envs}, device={str(self.device)!r})"
+
+
+class _LaunchedStep:
+    """The step as ``cuda_graph=False`` runs it: launched from Python, on the env's stream, every time."""
+
+    capturing = None  # never capturing: MuJoCo Warp's calls run as they are
+
+    def __init__(self, step: Callable[[torch.Tensor], tuple], streams: Callable):
+        self._step, self._streams = step, streams
+
+    def __call__(self, actions: torch.Tensor) -> tuple:
+        with self._streams():
+            return self._step(actions)
+
+    def close(self) -> None:
+        pass
+
+
+class _GraphedStep:
+    """The step as ``cuda_graph=True`` runs it, all of it here: the first :data:`_EAGER_STEPS` steps as they
+    are (they load every kernel), then one capture (:class:`_StepGraphs`, from ``make_graphs``), then replays;
+    a failed capture is raised again on every later step.
+
+    A replay reads its actions from one buffer and writes its outputs into the
+    same tensors every time, so the caller gets copies, made on the caller's
+    stream (the graphs' stream waits for nothing of the caller's afterwards).
+    """
+
+    def __init__(self, step: Callable[[torch.Tensor], tuple], streams: Callable, num_envs: int,
+                 device: torch.device, make_graphs: Callable[[], _StepGraphs]):
+        self._step, self._streams, self._device, self._make_graphs = step, streams, device, make_graphs
+        self._actions = torch.zeros(num_envs, dtype=torch.int64, device=device)
+        self._eager_steps = 0
+        self._graphs: _StepGraphs | None = None  # once captured
+        self._outputs: tuple | None = None  # the tensors every replay writes
+        self._error: RuntimeError | None = None  # why capturing failed, once it has
+        self.capturing: _StepGraphs | None = None  # the graphs being captured, while they are
+
+    def __call__(self, actions: torch.Tensor) -> tuple:
+        if self._error is not None:
+            raise self._error
+        with self._streams():
+            self._actions.copy_(actions)
+            if self._graphs is None and self._eager_steps < _EAGER_STEPS:
+                self._eager_steps += 1
+                outputs = self._step(self._actions)
+            else:
+                if self._graphs is None:
+                    self._capture()
+                self._graphs.replay()
+                outputs = self._outputs
+        return _copies(outputs)
+
+    def _capture(self) -> None:
+        """Captures the step of :attr:`_actions` (capturing runs nothing).
+
+        Python's cyclic garbage collector is held off meanwhile: a tensor or a
+        Warp array it freed would be freed on a stream one library captures
+        unknown to the other.
+        """
+        if self._device.type == "cuda":
+            torch.cuda.synchronize(self._device)
+        gc.collect()
+        collecting = gc.isenabled()
+        gc.disable()
+        graphs = self.capturing = self._make_graphs()
+        try:
+            self._outputs = graphs.capture(lambda: self._step(self._actions))
+        except Exception as error:
+            self._error = RuntimeError(
+                f"cuda_graph=True: capturing the step failed ({type(error).__name__}: {error}); this env stepped no "
+                "further: make a new one with cuda_graph=False")
+            raise self._error from error
+        finally:
+            self.capturing = None
+            if collecting:
+                gc.enable()
+        self._graphs = graphs
+
+    def close(self) -> None:
+        self._graphs = self._outputs = None
 
 
 class _StepGraphs:
