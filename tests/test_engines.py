@@ -6,14 +6,16 @@ import pathlib
 import numpy as np
 import pytest
 
-from mjmaze.train import engines
+from mjmaze.train import checkpoint, engines
+from mjmaze.train.settings import Args
 
 
-def write_run(folder, engine, seed, values, scenario="two_colour", complexity=1, updates_per_bin=4):
+def write_run(folder, engine, seed, values, scenario="two_colour", complexity=1, updates_per_bin=4, **learner):
     """A run folder as train.a2c leaves it: config.json and one metrics line per update (2,048 steps each)."""
     folder.mkdir(parents=True)
+    defaults = Args()
     config = {"scenario": scenario, "complexity": complexity, "seed": seed, "engine": engine, "num_envs": 16,
-              "env_id": f"{engine}-id"}
+              "env_id": f"{engine}-id", **{key: getattr(defaults, key) for key in checkpoint.LEARNER_KEYS}, **learner}
     (folder / "config.json").write_text(json.dumps(config))
     per_update = engines.BIN_STEPS // updates_per_bin
     lines = [json.dumps({"step": (i + 1) * per_update, "duration": value})
@@ -86,3 +88,24 @@ def test_runs_of_one_engine_under_two_env_ids_are_kept_apart_and_not_averaged(tm
     assert sorted(r["env_id"] for r in data["runs"]) == ["vizdoom:two_color/1@paper", "vizdoom:two_color/1@paper+area"]
     with pytest.raises(ValueError, match="keep one env id"):
         engines.table(data)
+
+
+def test_runs_of_two_learners_are_two_curves_each_named_by_its_settings(tmp_path):
+    # Runs saved before 2026-11-29 trained with RMSprop eps 1e-5; today's learner uses 1e-8, as released.
+    data_file = tmp_path / "engines.json"
+    data = engines.add([write_run(tmp_path / "old", "mjmaze", 0, np.full(12, 440.0), eps=1e-5),
+                        write_run(tmp_path / "new", "mjmaze", 0, np.full(12, 470.0)),
+                        write_run(tmp_path / "v", "vizdoom", 0, np.full(12, 450.0), eps=1e-5)], data_file)
+    assert len(data["runs"]) == 3  # the same seed under two learners: two records
+    rows = engines.table(data).splitlines()[2:]
+    assert [row.split(" | ")[0] for row in rows] == ["| two_colour_1"] * 3 + ["| two_colour_1 (eps 1e-05)"] * 3
+    assert "not run" in rows[0] and "not run" not in rows[3]  # the ViZDoom run beside the mjmaze run of its learner
+    plots = engines.draw(data, tmp_path, None)
+    assert sorted(p.name for p in plots) == ["engines_two_colour_1.png", "engines_two_colour_1_eps1e-05.png"]
+
+
+def test_a_data_file_without_the_learners_settings_is_refused(tmp_path):
+    data_file = tmp_path / "engines.json"
+    data_file.write_text(json.dumps({"bin_steps": engines.BIN_STEPS, "runs": [{"setting": "two_colour_1"}]}))
+    with pytest.raises(ValueError, match="add those runs again"):
+        engines.read_data(data_file)

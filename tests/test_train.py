@@ -193,6 +193,16 @@ def test_a_checkpoint_of_another_run_is_refused(tmp_path):
     assert latest.read_bytes() == before
 
 
+def test_a_run_resumed_with_another_learner_is_refused_with_the_flags_that_go_on(tmp_path):
+    # Runs before 2026-11-29 saved RMSprop eps 1e-5; resumed under today's default (1e-8, as released), the
+    # optimizer would reload 1e-5 while config.json said 1e-8: refused, naming the flag that goes on as saved.
+    run = a2c.train(tiny(tmp_path, eps=1e-5))
+    with pytest.raises(checkpoint.CheckpointError, match=r"eps: checkpoint 1e-05 vs now 1e-08.*pass --eps 1e-05"):
+        a2c.train(tiny(tmp_path, total_steps=64, resume=True))
+    a2c.train(tiny(tmp_path, total_steps=64, resume=True, eps=1e-5))
+    assert json.loads((run / "config.json").read_text())["eps"] == 1e-5
+
+
 def test_a_run_from_before_head_bob_and_flashes_resumes_and_plays_only_without_them(tmp_path):
     run = a2c.train(tiny(tmp_path, head_bob=False, flashes=False))
     latest = checkpoint.checkpoints(run / "checkpoints")[-1]

@@ -16,8 +16,10 @@ from mjmaze.files import atomic_write
 
 PREFIX, SUFFIX = "step_", ".pt"
 # What must agree between a checkpoint and the run that loads it.
+# The learner's settings: a run resumed with others would be two learners' curve under one name.
+LEARNER_KEYS = ("lr", "alpha", "eps", "gamma", "value_coef", "entropy_coef", "max_grad_norm")
 IDENTITY_KEYS = ("scenario", "size", "num_items", "complexity", "num_envs", "num_steps", "head_bob", "flashes",
-                 "engine", "freedoom", "resize")
+                 "engine", "freedoom", "resize", *LEARNER_KEYS)
 # Settings that runs saved before they existed ran with (ViZDoom's frames: INTER_AREA until 2026-11-29).
 MISSING_MEANS = {"head_bob": False, "flashes": False, "engine": "mjmaze", "freedoom": "paper", "resize": "area"}
 # Settings that only the ViZDoom engine reads: an mjmaze run's value means nothing.
@@ -34,6 +36,15 @@ def identity_differences(saved: dict, now: dict) -> dict:
     on_mjmaze = setting_of(saved, "engine") == setting_of(now, "engine") == "mjmaze"
     return {k: (setting_of(saved, k), setting_of(now, k)) for k in IDENTITY_KEYS
             if setting_of(saved, k) != setting_of(now, k) and not (on_mjmaze and k in VIZDOOM_ONLY)}
+
+
+def flags(config: dict, keys) -> str:
+    """The command-line flags that give ``keys`` the values of a run's ``config`` (``--eps 1e-05 --no-flashes``)."""
+    words = []
+    for key in keys:
+        value, flag = setting_of(config, key), "--" + key.replace("_", "-")
+        words.append((flag if value else f"--no-{flag[2:]}") if isinstance(value, bool) else f"{flag} {value}")
+    return " ".join(words)
 
 
 class CheckpointError(RuntimeError):
@@ -71,5 +82,6 @@ def load(path: pathlib.Path, config: dict | None = None) -> dict:
         differ = identity_differences(state["config"], config)
         if differ:
             detail = ", ".join(f"{k}: checkpoint {a!r} vs now {b!r}" for k, (a, b) in differ.items())
-            raise CheckpointError(f"{path} belongs to a different run ({detail}); it was left untouched.")
+            raise CheckpointError(f"{path} belongs to a different run ({detail}); it was left untouched. To go on "
+                                  f"with it, pass {flags(state['config'], differ)}; or give another --run-name.")
     return state

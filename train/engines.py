@@ -64,6 +64,13 @@ def env_id(config: dict) -> str | None:
     return Args.from_config(config).env_id()
 
 
+def learner_label(learner: dict) -> str:
+    """How a record's learner differs from today's defaults (``"eps 1e-05"``); "" where it does not. Runs
+    of two learners are two curves: the table and plots keep them apart."""
+    defaults = Args()
+    return ", ".join(f"{key} {value:g}" for key, value in learner.items() if value != getattr(defaults, key))
+
+
 def run_record(run_dir: pathlib.Path) -> dict:
     """A run's curve on the fixed grid of :data:`BIN_STEPS` bins (from the first time limit on) and its evaluations."""
     run = curves.read_run(run_dir)
@@ -82,6 +89,7 @@ def run_record(run_dir: pathlib.Path) -> dict:
         "engine": checkpoint.setting_of(config, "engine"),
         "seed": int(config["seed"]),
         "env_id": env_id(config),
+        "learner": {key: config[key] for key in checkpoint.LEARNER_KEYS},
         "field": published.curve_field(config["scenario"]),
         "steps": int(run["steps"].max()),
         # Each bin's mean of the updates' training means (None where no episode ended), 4 significant digits.
@@ -91,22 +99,35 @@ def run_record(run_dir: pathlib.Path) -> dict:
     }
 
 
-def read_data(path: pathlib.Path = DATA) -> dict:
+def read_data(path: pathlib.Path = DATA, learners: bool = True) -> dict:
+    """The data file (``learners``: refuse records that predate the learner's settings; :func:`add` takes them,
+    to replace them)."""
     if not path.exists():
         return {"bin_steps": BIN_STEPS, "runs": []}
     data = json.loads(path.read_text())
     if data.get("bin_steps") != BIN_STEPS:
         raise ValueError(f"{path} holds {data.get('bin_steps')}-step bins, this version {BIN_STEPS}: add the runs again")
+    if learners and any("learner" not in r for r in data["runs"]):
+        raise ValueError(f"{path} holds runs without their learner's settings: add those runs again")
     return data
 
 
+def groups(data: dict) -> list[tuple[str, str]]:
+    """The ``(setting, learner label)`` pairs the data holds: one curve pair, one table block, one plot each."""
+    return sorted({(r["setting"], learner_label(r["learner"])) for r in data["runs"]})
+
+
 def add(run_dirs: list[pathlib.Path], path: pathlib.Path = DATA) -> dict:
-    """Puts each run's record into the data file, replacing the record of the same setting, env id and seed."""
-    data = read_data(path)
+    """Puts each run's record into the data file, replacing the record of the same setting, env id, learner and seed."""
+    data = read_data(path, learners=False)
+
+    def same_run(a: dict, b: dict) -> bool:  # a record without its learner's settings is replaced by its run's
+        return ((a["setting"], a["env_id"], a["seed"]) == (b["setting"], b["env_id"], b["seed"])
+                and ("learner" not in a or learner_label(a["learner"]) == learner_label(b["learner"])))
+
     for run_dir in run_dirs:
         record = run_record(pathlib.Path(run_dir))
-        key = (record["setting"], record["env_id"], record["seed"])
-        data["runs"] = [r for r in data["runs"] if (r["setting"], r["env_id"], r["seed"]) != key] + [record]
+        data["runs"] = [r for r in data["runs"] if not same_run(r, record)] + [record]
     data["runs"].sort(key=lambda r: (r["setting"], r["engine"], r["seed"]))
     files.atomic_write_json(path, data)
     return data
@@ -157,10 +178,12 @@ def greedy_test_at(records: list[dict], step: int) -> str:
     return f"{np.mean(values):.4g}" if values else "–"
 
 
-def engine_records(data: dict, setting: str, engine: str) -> list[dict]:
-    """One engine's records of a setting, its seeds; records of one engine under two env ids (ViZDoom's
-    frames resized two ways, mjmaze's scenario at two versions) are not seeds of one curve: an error."""
-    records = [r for r in data["runs"] if r["setting"] == setting and r["engine"] == engine]
+def engine_records(data: dict, setting: str, engine: str, learner: str = "") -> list[dict]:
+    """One engine's records of a setting under one learner (:func:`learner_label`), its seeds; records of one
+    engine under two env ids (ViZDoom's frames resized two ways, mjmaze's scenario at two versions) are not
+    seeds of one curve: an error."""
+    records = [r for r in data["runs"] if r["setting"] == setting and r["engine"] == engine
+               and learner_label(r["learner"]) == learner]
     ids = sorted({r["env_id"] for r in records})
     if len(ids) > 1:
         raise ValueError(f"{setting} on {engine} holds runs of {ids}: keep one env id in {DATA.name} per engine")
@@ -174,10 +197,11 @@ def table(data: dict) -> str:
     lines = ["| setting | paper's level (its step) | mjmaze: obs to reach it (seeds) | ViZDoom: obs (seeds) "
              "| mjmaze ÷ ViZDoom | greedy test there: mjmaze / ViZDoom |",
              "|---|---|---|---|---|---|"]
-    for setting in sorted({r["setting"] for r in data["runs"]}):
+    for setting, learner in groups(data):
         scenario = setting.rpartition("_")[0]
         units, digits = published.curve_units(scenario), published.of(scenario).metric_digits
-        by_engine = {engine: engine_records(data, setting, engine) for engine in ENGINE_NAMES}
+        by_engine = {engine: engine_records(data, setting, engine, learner) for engine in ENGINE_NAMES}
+        name = f"{setting} ({learner})" if learner else setting
         for step, level in paper_levels(setting):
             cells, reached = [], {}
             for engine, records in by_engine.items():
@@ -189,7 +213,7 @@ def table(data: dict) -> str:
                 cells.append(f"{_millions(at, last)} ({len(records)})")
             ratio = _ratio(reached)
             greedy = " / ".join(greedy_test_at(records, step) if records else "–" for records in by_engine.values())
-            lines.append(f"| {setting} | {level:.{digits}f} {units} ({step / 1e6:g}M) | {cells[0]} | {cells[1]} "
+            lines.append(f"| {name} | {level:.{digits}f} {units} ({step / 1e6:g}M) | {cells[0]} | {cells[1]} "
                          f"| {ratio} | {greedy} |")
     return "\n".join(lines)
 
@@ -210,7 +234,12 @@ def _ratio(reached: dict) -> str:
     return "neither yet"
 
 
-def figure(data: dict, setting: str):
+def plot_name(setting: str, learner: str) -> str:
+    """``engines_<setting>.png``; a learner other than today's adds its settings (``_eps1e-05``)."""
+    return f"engines_{setting}" + (f"_{learner.replace(', ', '_').replace(' ', '')}" if learner else "") + ".png"
+
+
+def figure(data: dict, setting: str, learner: str = ""):
     """Both engines' training curves (mean over seeds, each seed thin) and greedy test evaluations, and the paper's points."""
     from matplotlib.figure import Figure
 
@@ -219,7 +248,7 @@ def figure(data: dict, setting: str):
     ax = fig.subplots()
     reach = 0
     for colour, (engine, name) in zip(("C0", "C1"), ENGINE_NAMES.items()):
-        records = engine_records(data, setting, engine)
+        records = engine_records(data, setting, engine, learner)
         if not records:
             continue
         for r in records:
@@ -237,7 +266,7 @@ def figure(data: dict, setting: str):
              if s <= max(reach * 1.5, LEVEL_STEPS[0])]
     if paper:
         ax.plot(*zip(*paper), color="black", marker="s", linestyle=":", label="the paper (read off its plots)")
-    ax.set_title(f"{setting}: one A2C on both engines", fontsize=10)
+    ax.set_title(f"{setting}: one A2C on both engines" + (f" ({learner})" if learner else ""), fontsize=10)
     ax.set_xlabel("agent steps (observations)")
     ax.set_ylabel(published.curve_units(scenario))
     ax.grid(alpha=0.3)
@@ -247,8 +276,10 @@ def figure(data: dict, setting: str):
 
 def draw(data: dict, docs: pathlib.Path = DOCS, page: pathlib.Path | None = LEARNING_PAGE) -> list[pathlib.Path]:
     """Writes each setting's plot into ``docs`` and the table into ``page`` (between its markers); returns the plots."""
-    written = [save_figure(figure(data, setting), docs / f"engines_{setting}.png")
-               for setting in sorted({r["setting"] for r in data["runs"]})]
+    written = [save_figure(figure(data, setting, learner), docs / plot_name(setting, learner))
+               for setting, learner in groups(data)]
+    for stale in set(docs.glob("engines_*.png")) - set(written):  # a group the data no longer holds
+        stale.unlink()
     if page is not None:
         text = page.read_text()
         if TABLE_START not in text or TABLE_END not in text:
