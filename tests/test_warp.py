@@ -20,7 +20,7 @@ import mjmaze
 from mjmaze.backends import suite
 from mjmaze.build import mjcf
 from mjmaze.drawing import look
-from mjmaze.game import core, registry
+from mjmaze.game import arrays, core, registry
 
 pytestmark = [pytest.mark.warp, pytest.mark.slow]
 torch = pytest.importorskip("torch")
@@ -283,6 +283,26 @@ def test_a_step_can_be_captured_as_cuda_graphs(scenario, mode, monkeypatch):
         batch._obs[..., [2, 1, 0]]  # an index sent from the host,
     with pytest.raises(AssertionError, match="torch op"):
         guarded_warp(lambda: batch._obs.float())  # and torch among Warp's calls
+
+
+def test_dooms_light_in_warps_kernels_is_the_cpus_bit_for_bit():
+    # Two Warp kernels light the Warp backend's frames (mjmaze.drawing.warp_light); the CPU lights its own in
+    # numpy's float32 steps (or numba's, the same). Same frames, depths and poses: the same bytes, every branch
+    # taken (floor and ceiling rows, a column's wall, things before it, the nearest bin's saturation).
+    rng = np.random.default_rng(0)
+    batch, height, width = 6, 64, 112
+    frames = rng.integers(0, 256, (batch, height, width, 3), dtype=np.uint8)
+    inverse_depth = rng.uniform(0.15, 12.0, (batch, height, width)).astype(np.float32)
+    inverse_depth[:, :, ::7] = np.float32(0.3)  # deep columns: their wall, with things before it elsewhere
+    eye = np.column_stack([rng.uniform(-2, 2, batch), rng.uniform(-2, 2, batch), np.full(batch, mjcf.EYE_HEIGHT)])
+    yaw = rng.uniform(-np.pi, np.pi, batch)
+    on_cpu = look.DoomLight(np, "cpu", width, height, grid_size=5, cell_size=1.0)
+    on_cpu._compiled = None  # numpy's passes (numba's give the same bytes: tests/test_look.py)
+    in_warp = look.DoomLight(arrays.namespace(torch.zeros(1)), "cpu", width, height, grid_size=5, cell_size=1.0)
+    expected = on_cpu(frames, inverse_depth, eye, yaw)
+    lit = in_warp(torch.from_numpy(frames), torch.from_numpy(inverse_depth), torch.from_numpy(eye), torch.from_numpy(yaw))
+    assert np.array_equal(lit.numpy(), expected)
+    assert (expected == 255).any() and (expected < frames).any()
 
 
 def _carried_tensors(batch) -> dict[str, tuple[int, int]]:

@@ -192,7 +192,9 @@ class MazeBatchEnv(batch.BatchEnv):
         self._host_model = mjm
         self._hold_arena(rules, ids, mesh_of_config, box_z, first)
         # What Doom draws beyond the scene, for every world at once: the CPU envs' pipeline.
-        self._pipeline = look.FramePipeline(self.xp, self.device, view, rules, mjm, ids)
+        # Doom's light runs Warp kernels: through _run_warp, as MuJoCo Warp's calls (looked up per call).
+        self._pipeline = look.FramePipeline(self.xp, self.device, view, rules, mjm, ids,
+                                            run_warp=lambda calls: self._run_warp(calls))
         self._timestep = float(mjm.opt.timestep)
         self._actions = torch.tensor(rules.actions, dtype=torch.float64, device=self.device)  # (A, 2): forward, turn
         self._put_on_device(mjm, ids, render_segmentation)

@@ -282,58 +282,62 @@ class DoomLight:
     Made once per env (or batch) and device; call it on every frame.
     """
 
-    def __init__(self, xp, device, width: int, height: int, grid_size: int, cell_size: float):
+    def __init__(self, xp, device, width: int, height: int, grid_size: int, cell_size: float, run_warp=None):
+        """``run_warp``: on torch, what runs the light's Warp launches (the Warp backend's; see
+        :class:`mjmaze.drawing.warp_light.WarpLight`)."""
         self._xp = xp
         # Tangents of each column's and row's ray (right, up) in Doom's projection (mjcf.set_ego_projection).
-        self._right = xp.asarray((np.arange(width) + 0.5 - width / 2) / (mjcf.DOOM_FOCAL_ACROSS * width),
-                                 dtype=xp.float32, device=device)
+        right = ((np.arange(width) + 0.5 - width / 2) / (mjcf.DOOM_FOCAL_ACROSS * width)).astype(np.float32)
         up = (height / 2 - np.arange(height) - 0.5) / (mjcf.DOOM_FOCAL_DOWN * height)
-        self._up = xp.asarray(np.abs(up), dtype=xp.float32, device=device)
-        self._below = xp.asarray(up < 0, device=device)
         # The gains by (surface, inverse depth), a surface's from surface x bins, each repeated for
         # the three channels: numpy multiplies by a gain broadcast over the channels ~3x slower.
-        self._gains = xp.asarray(np.repeat(light_table().reshape(-1, 1), 3, axis=1), device=device)
+        gains = np.repeat(light_table().reshape(-1, 1), 3, axis=1)
         # A pixel's surface as where its gains start in the table.
-        self._flat_start = xp.asarray(np.where(up < 0, FLOOR, CEILING)[:, None] * _LIGHT_BINS, dtype=xp.int32,
-                                      device=device)  # (H, 1)
-        self._thing_start = THING * _LIGHT_BINS
+        flat_start = (np.where(up < 0, FLOOR, CEILING) * _LIGHT_BINS).astype(np.int32)
         self._cell, self._half_grid = float(cell_size), grid_size / 2
         self._face = wall_boxes.WALL_THICKNESS / 2 / self._cell  # a wall face's offset from its grid line, in cells
         self._on_face = _ON_PLANE / self._cell
-        # An array, not a Python number: xp.minimum with a scalar would make torch build a tensor per call.
-        self._white = xp.asarray(254.5, dtype=xp.float32, device=device)
-        self._top_bin = xp.asarray(_LIGHT_BINS - 1, dtype=xp.float32, device=device)
-        self._half = xp.asarray(0.5, dtype=xp.float32, device=device)
-        # On the CPU, one compiled pass gives the same frames ~3x sooner (mjmaze.drawing.compiled_light), where numba is.
-        self._compiled = self._compiled_constants(up < 0) if arrays.on_host(xp) and compiled_light.available() else None
+        self._thing_start = THING * _LIGHT_BINS
+        constants = self._constants(right, np.abs(up).astype(np.float32), up < 0, gains, flat_start)
+        # Torch frames are the Warp backend's: two Warp kernels light them (~30 torch passes otherwise).
+        if arrays.on_host(xp):
+            self._warp = None
+        else:
+            from mjmaze.drawing import warp_light  # imports Warp: only the Warp backend draws on torch
 
-    def _compiled_constants(self, below: np.ndarray) -> tuple:
-        """What :func:`mjmaze.drawing.compiled_light.light` takes beside the frames: this light's tables and
-        constants as float32, as the numpy path computes with them (NEP 50: a Python float meets a
-        float32 array as float32)."""
+            self._warp = warp_light.WarpLight(constants, device)
+        self._run_warp = run_warp
+        # On the CPU, one compiled pass gives the same frames ~3x sooner (mjmaze.drawing.compiled_light), where numba is.
+        self._compiled = constants if arrays.on_host(xp) and compiled_light.available() else None
+        # numpy without numba: the passes below.
+        self._right, self._up, self._below, self._gains = right, np.abs(up).astype(np.float32), up < 0, gains
+        self._flat_start = flat_start[:, None]  # (H, 1)
+        self._white, self._top_bin, self._half = np.float32(254.5), np.float32(_LIGHT_BINS - 1), np.float32(0.5)
+
+    def _constants(self, right, up_tangent, below, gains, flat_start) -> tuple:
+        """What :func:`mjmaze.drawing.compiled_light.light` and :class:`~mjmaze.drawing.warp_light.WarpLight`
+        take beside the frames: this light's tables and constants as float32, as the numpy path computes with
+        them (NEP 50: a Python float meets a float32 array as float32)."""
         f32 = np.float32
-        return (self._right, self._up, below, np.ascontiguousarray(self._gains),
-                np.ascontiguousarray(self._flat_start[:, 0]), f32(self._cell), f32(self._half_grid), f32(self._face),
-                f32(self._on_face), f32(_ON_PLANE), f32(wall_boxes.WALL_HEIGHT - _ON_PLANE), f32(_LIGHT_BINS * _NEAREST),
-                f32(_LIGHT_BINS - 1), (NORTH_SOUTH_WALL * _LIGHT_BINS, EAST_WEST_WALL * _LIGHT_BINS),
-                self._thing_start)
+        return (right, up_tangent, below, np.ascontiguousarray(gains), np.ascontiguousarray(flat_start), f32(self._cell),
+                f32(self._half_grid), f32(self._face), f32(self._on_face), f32(_ON_PLANE),
+                f32(wall_boxes.WALL_HEIGHT - _ON_PLANE), f32(_LIGHT_BINS * _NEAREST), f32(_LIGHT_BINS - 1),
+                (NORTH_SOUTH_WALL * _LIGHT_BINS, EAST_WEST_WALL * _LIGHT_BINS), self._thing_start)
 
     def _off_wall_face(self, cells):
         """Cells from a coordinate (in cells from the grid's first line) to the nearest wall face across it."""
-        xp = self._xp
-        off_line = xp.abs(cells - xp.round(cells))
-        return xp.minimum(xp.abs(off_line - self._face), off_line)  # a wall's side, or an end or the outer wall
+        off_line = np.abs(cells - np.round(cells))
+        return np.minimum(np.abs(off_line - self._face), off_line)  # a wall's side, or an end or the outer wall
 
     def _surface_start(self, eye_x, eye_y, cos, sin, right, depth):
         """Where the gains of the surface ``depth`` metres ahead along a column's ray start in the table:
         a wall's side if that point lies on a wall face across x (a wall running north-south) or y
         (in cells from the grid's first lines), else a thing's."""
-        xp = self._xp
         x = eye_x / self._cell + self._half_grid + depth * ((cos + right * sin) / self._cell)
         y = eye_y / self._cell + self._half_grid + depth * ((sin - right * cos) / self._cell)
         off_x, off_y = self._off_wall_face(x), self._off_wall_face(y)
-        wall = xp.where(off_y < off_x, EAST_WEST_WALL * _LIGHT_BINS, NORTH_SOUTH_WALL * _LIGHT_BINS)
-        return xp.astype(xp.where(xp.minimum(off_x, off_y) <= self._on_face, wall, self._thing_start), xp.int32)
+        wall = np.where(off_y < off_x, EAST_WEST_WALL * _LIGHT_BINS, NORTH_SOUTH_WALL * _LIGHT_BINS)
+        return np.where(np.minimum(off_x, off_y) <= self._on_face, wall, self._thing_start).astype(np.int32)
 
     def __call__(self, frames, inverse_depth, eye, yaw):
         """``frames`` (uint8 ``(B, H, W, 3)``) in Doom's light: new frames.
@@ -345,37 +349,33 @@ class DoomLight:
         xp = self._xp
         eye, yaw = xp.astype(eye, xp.float32), xp.astype(yaw, xp.float32)
         cos, sin = xp.cos(yaw), xp.sin(yaw)
+        if self._warp is not None:
+            return self._warp(frames, inverse_depth, eye, cos, sin, self._run_warp)
         if self._compiled is not None:
             lit = np.empty(frames.shape, dtype=np.uint8)
             compiled_light.light(frames, inverse_depth, eye, cos, sin, self._compiled, lit)
             return lit
         # The floor and the ceiling: pixels at least as deep as their row's ray meets the plane.
-        height_above = xp.where(self._below, eye[:, 2:3] - _ON_PLANE, wall_boxes.WALL_HEIGHT - _ON_PLANE - eye[:, 2:3])
+        height_above = np.where(self._below, eye[:, 2:3] - _ON_PLANE, wall_boxes.WALL_HEIGHT - _ON_PLANE - eye[:, 2:3])
         flat = inverse_depth < (self._up / height_above)[:, :, None]  # (B, H, W)
         # A column's wall is the deepest pixel in it (all else stands before it): its surface is the column's.
-        wall_depth = 1 / xp.min(inverse_depth, axis=1)  # (B, W)
+        wall_depth = 1 / np.min(inverse_depth, axis=1)  # (B, W)
         wall_start = self._surface_start(eye[:, 0:1], eye[:, 1:2], cos[:, None], sin[:, None], self._right, wall_depth)
         on_wall = inverse_depth <= (1 / (wall_depth - _ON_PLANE))[:, None, :]
-        start = xp.where(flat, self._flat_start, xp.where(on_wall, wall_start[:, None, :], self._thing_start))
+        start = np.where(flat, self._flat_start, np.where(on_wall, wall_start[:, None, :], self._thing_start))
         # The pixels before the wall (things) take the surface of where they lie, as each pixel did
-        # before (a thing across a grid line is lit as a wall there): found per pixel, few on a CPU.
-        before = ~(flat | on_wall)
-        if arrays.on_host(xp):
-            pixels = np.flatnonzero(before)
-            if len(pixels):
-                world, row, column = np.unravel_index(pixels, before.shape)
-                start[world, row, column] = self._surface_start(
-                    eye[world, 0], eye[world, 1], cos[world], sin[world], self._right[column],
-                    1 / inverse_depth[world, row, column])
-        else:  # every pixel: picking some out would wait on the GPU
-            every = self._surface_start(eye[:, 0, None, None], eye[:, 1, None, None], cos[:, None, None],
-                                        sin[:, None, None], self._right, 1 / inverse_depth)
-            start = xp.where(before, every, start)
-        bins = xp.astype(xp.minimum(inverse_depth * (_LIGHT_BINS * _NEAREST), self._top_bin), xp.int32)
-        gain = xp.reshape(xp.take(self._gains, xp.reshape(start + bins, (-1,)), axis=0), frames.shape)
+        # before (a thing across a grid line is lit as a wall there): found per pixel, few.
+        pixels = np.flatnonzero(~(flat | on_wall))
+        if len(pixels):
+            world, row, column = np.unravel_index(pixels, flat.shape)
+            start[world, row, column] = self._surface_start(
+                eye[world, 0], eye[world, 1], cos[world], sin[world], self._right[column],
+                1 / inverse_depth[world, row, column])
+        bins = np.minimum(inverse_depth * (_LIGHT_BINS * _NEAREST), self._top_bin).astype(np.int32)
+        gain = np.take(self._gains, (start + bins).reshape(-1), axis=0).reshape(frames.shape)
         # Saturate, as Doom's brightest colormap does: a bright sprite near the eye goes past 255.
-        lit = xp.minimum(frames * gain, self._white)
-        return xp.astype(lit + self._half, xp.uint8)
+        lit = np.minimum(frames * gain, self._white)
+        return (lit + self._half).astype(np.uint8)
 
 
 # Doom's full-screen flashes: the tint of the rules' counters (mjmaze.game.arrays: damage_count,
@@ -422,16 +422,16 @@ class FramePipeline:
     every world (:mod:`mjmaze.backends.warp`). Made once per model and device.
     """
 
-    def __init__(self, xp, device, view: View, rules, model: mujoco.MjModel, ids):
+    def __init__(self, xp, device, view: View, rules, model: mujoco.MjModel, ids, run_warp=None):
         """``rules``: the scenario's core (:class:`mjmaze.game.core.MazeRules`: its ``objects`` and
         ``layout``); ``model`` and ``ids``: the arena compiled
-        (:class:`mjmaze.build.arena.ArenaIds`)."""
+        (:class:`mjmaze.build.arena.ArenaIds`); ``run_warp``: :class:`DoomLight`'s."""
         self._xp, self._device = xp, device
         self._width, self._height = view.width, view.height
         textured = view.textured
         self.sprites = SpriteView(xp, device, model, rules.objects, ids, view.width) if textured else None
-        self.light = (DoomLight(xp, device, view.width, view.height, rules.layout.grid_size, rules.layout.cell_size)
-                      if textured else None)
+        self.light = (DoomLight(xp, device, view.width, view.height, rules.layout.grid_size, rules.layout.cell_size,
+                                run_warp) if textured else None)
         # The pistol is drawn where the released runs drew it: in the paper's look.
         self._head_bob, self._pistol, self._flashes = view.head_bob, view.pistol and textured, view.flashes
         self._tints: dict[tuple[int, int], tuple] = {}  # (damage, bonus) -> the flash's (rgb, alpha), on numpy
