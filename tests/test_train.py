@@ -409,10 +409,16 @@ def test_the_main_job_trains_evaluates_beside_chance_draws_films_and_says_so(tmp
     printed = capsys.readouterr().out.strip().splitlines()[-3:]
     assert printed == summary["lines"]
     assert printed[0].startswith(f"trained: A2C on {mjmaze.GYM_IDS['labyrinth']} size 5, 64 agent steps")
-    # 64 steps teach nothing: the summary says so, and evaluates sampled actions too.
-    assert printed[1].startswith("not learned yet: success % on the test mazes greedy ")
-    assert ", sampled " in printed[1] and "a random policy" in printed[1] and (run / "eval_sampled.json").exists()
-    assert summary["learned"] is False and str(run / "curve.png") in printed[2]
+    # 64 steps teach nothing, so greedy play lags and sampled actions are evaluated too; the verdict is the
+    # better of the two beside chance. (Four test episodes each: a sampled 3 of 4 beside chance's 1 reads as
+    # learned, so the verdict is checked against its rule, not assumed.)
+    greedy, sampled, chance = (float(x) for x in re.search(
+        r"greedy ([\d.]+), sampled ([\d.]+), a random policy ([\d.]+)", printed[1]).groups())
+    assert (run / "eval_sampled.json").exists() and greedy < 60
+    assert summary["learned"] is first_run.learned(max(greedy, sampled), chance)
+    verdict = "learned: " if summary["learned"] else "not learned yet: "
+    assert printed[1].startswith(verdict + "success % on the test mazes greedy ")
+    assert str(run / "curve.png") in printed[2]
 
 
 def test_the_main_job_calls_an_agent_learned_at_60_percent_and_three_times_chance():
