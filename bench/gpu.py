@@ -264,7 +264,11 @@ def _graph_training(device: str, quick: bool) -> dict:
 def training(device: str, quick: bool) -> dict:
     """A2C training obs/s on the Warp backend (bench/warp.py's ``bench_training``), and the host waits in a rollout."""
     bench = _sibling("warp")
-    results = {"rollout_syncs": rollout_syncs(device, quick)}
+    try:  # its own figure, whatever happens to it
+        results = {"rollout_syncs": rollout_syncs(device, quick)}
+    except Exception as error:  # noqa: BLE001
+        results = {"rollout_syncs": {"error": f"{type(error).__name__}: {error}", "traceback": traceback.format_exc()}}
+        print(f"  train  host waits per rollout: failed: {traceback.format_exc()}", flush=True)
     for worlds, updates in (((8, 3),) if quick else ((1024, 12), (4096, 8))):
         rate = bench.bench_training(worlds, device, updates)
         results[str(worlds)] = rate
@@ -275,23 +279,43 @@ def training(device: str, quick: bool) -> dict:
 def rollout_syncs(device: str, quick: bool) -> dict:
     """How often one A2C rollout on the Warp backend makes the host wait for the device (torch's sync debug mode
     counts them): a wait per step keeps the card idle while Python catches up."""
-    import warnings
-
     import torch
     from mjmaze.train import a2c
     from mjmaze.train import settings as run_settings
     from mjmaze.train.model import Agent
 
-    from mjmaze.backends.warp import MazeBatchEnv
-
     worlds, steps = (8, 16) if quick else (1024, 32)
     args = run_settings.Args(scenario="labyrinth", size=9, backend="warp", device=device, num_envs=worlds,
                              num_steps=steps, progress=False)
-    envs = MazeBatchEnv(worlds, "labyrinth", device=device, size=9, autoreset_mode="same_step")
-    learner = a2c._Learner(args, Agent(envs.single_action_space.n).to(device), None, torch.device(device))
-    learner.restart(envs, seed=0)
-    learner.rollout(envs)  # warm-up: first launches, allocations (its graph freed here)
-    learner.hidden = learner.hidden.detach()
+    envs = a2c.training_envs(args, torch.device(device))()  # as training makes them
+    try:
+        learner = a2c._Learner(args, Agent(envs.single_action_space.n).to(device), None, torch.device(device))
+        learner.restart(envs, seed=0)
+        learner.rollout(envs)  # warm-up: first launches, allocations (its graph freed here)
+        learner.hidden = learner.hidden.detach()
+        caught, episodes = _counted_rollout(learner, envs, device)
+    finally:
+        envs.close()
+        learner = None
+        if device.startswith("cuda"):
+            torch.cuda.empty_cache()  # before the training processes start
+    if not device.startswith("cuda"):
+        print(f"  train  host waits in one rollout: counted on a CUDA device only ({episodes} episodes ended)", flush=True)
+        return {"skipped": "counted on a CUDA device only"}
+    syncs = [w for w in caught if "synchroniz" in str(w.message)]
+    print(f"  train  host waits in one rollout ({worlds} envs x {steps} steps, episodes read once): {len(syncs)}",
+          flush=True)
+    return {"worlds": worlds, "steps": steps, "syncs": len(syncs),
+            "kinds": sorted({str(w.message).splitlines()[0][:80] for w in syncs})}
+
+
+def _counted_rollout(learner, envs, device: str) -> tuple[list, int]:
+    """One rollout with torch's sync debug mode warning on every host wait (on CUDA): the warnings, and the
+    episodes that ended."""
+    import warnings
+
+    import torch
+
     cuda = device.startswith("cuda")  # the rollout runs on Warp's CPU device too (--quick), uncounted
     if cuda:
         torch.cuda.synchronize(device)
@@ -304,15 +328,7 @@ def rollout_syncs(device: str, quick: bool) -> dict:
         finally:
             if cuda:
                 torch.cuda.set_sync_debug_mode("default")
-    envs.close()
-    if not cuda:
-        print(f"  train  host waits in one rollout: counted on a CUDA device only ({episodes} episodes ended)", flush=True)
-        return {"skipped": "counted on a CUDA device only"}
-    syncs = [w for w in caught if "synchroniz" in str(w.message)]
-    print(f"  train  host waits in one rollout ({worlds} envs x {steps} steps, episodes read once): {len(syncs)}",
-          flush=True)
-    return {"worlds": worlds, "steps": steps, "syncs": len(syncs),
-            "kinds": sorted({str(w.message).splitlines()[0][:80] for w in syncs})}
+    return caught, episodes
 
 
 def _gl_renderer() -> str:

@@ -200,7 +200,11 @@ def test_a_run_resumed_with_another_learner_is_refused_with_the_flags_that_go_on
     with pytest.raises(checkpoint.CheckpointError, match=r"eps: checkpoint 1e-05 vs now 1e-08.*pass --eps 1e-05"):
         a2c.train(tiny(tmp_path, total_steps=64, resume=True))
     a2c.train(tiny(tmp_path, total_steps=64, resume=True, eps=1e-5))
-    assert json.loads((run / "config.json").read_text())["eps"] == 1e-5
+    config = json.loads((run / "config.json").read_text())
+    assert config["eps"] == 1e-5
+    # Evaluating a network needs no optimizer: a checkpoint loads whatever the learner's settings say.
+    (run / "config.json").write_text(json.dumps({**config, "eps": 1e-8, "lr": 1e-3}))
+    assert policy.load_run(run)[2]["step"] == 64
 
 
 def test_a_run_from_before_head_bob_and_flashes_resumes_and_plays_only_without_them(tmp_path):

@@ -9,6 +9,7 @@ and is left exactly as it was.
 from __future__ import annotations
 
 import pathlib
+import shlex
 
 import torch
 
@@ -20,8 +21,13 @@ PREFIX, SUFFIX = "step_", ".pt"
 LEARNER_KEYS = ("lr", "alpha", "eps", "gamma", "value_coef", "entropy_coef", "max_grad_norm")
 IDENTITY_KEYS = ("scenario", "size", "num_items", "complexity", "num_envs", "num_steps", "head_bob", "flashes",
                  "engine", "freedoom", "resize", *LEARNER_KEYS)
+# What a checkpoint's network played (evaluating it needs no optimizer): the identity less the learner.
+PLAY_KEYS = tuple(key for key in IDENTITY_KEYS if key not in LEARNER_KEYS)
 # Settings that runs saved before they existed ran with (ViZDoom's frames: INTER_AREA until 2026-11-29).
-MISSING_MEANS = {"head_bob": False, "flashes": False, "engine": "mjmaze", "freedoom": "paper", "resize": "area"}
+MISSING_MEANS = {"head_bob": False, "flashes": False, "engine": "mjmaze", "freedoom": "paper", "resize": "area",
+                 # Every run saved its learner; a config written by hand without it means the learner until 2026-11-29.
+                 "lr": 7e-4, "alpha": 0.99, "eps": 1e-5, "gamma": 0.99, "value_coef": 0.5, "entropy_coef": 0.001,
+                 "max_grad_norm": 0.5}
 # Settings that only the ViZDoom engine reads: an mjmaze run's value means nothing.
 VIZDOOM_ONLY = ("freedoom", "resize")
 
@@ -31,11 +37,20 @@ def setting_of(config: dict, key: str):
     return config.get(key, MISSING_MEANS.get(key))
 
 
-def identity_differences(saved: dict, now: dict) -> dict:
-    """``{key: (saved value, value now)}`` of the :data:`IDENTITY_KEYS` that differ between two run configs."""
+def identity_differences(saved: dict, now: dict, keys: tuple[str, ...] = IDENTITY_KEYS) -> dict:
+    """``{key: (saved value, value now)}`` of ``keys`` (:data:`IDENTITY_KEYS`) that differ between two run configs."""
     on_mjmaze = setting_of(saved, "engine") == setting_of(now, "engine") == "mjmaze"
-    return {k: (setting_of(saved, k), setting_of(now, k)) for k in IDENTITY_KEYS
+    return {k: (setting_of(saved, k), setting_of(now, k)) for k in keys
             if setting_of(saved, k) != setting_of(now, k) and not (on_mjmaze and k in VIZDOOM_ONLY)}
+
+
+def learner_label(config: dict) -> str:
+    """How a run's learner (its config's, or a record's ``learner``: :data:`LEARNER_KEYS`) differs from today's
+    defaults, for people to read (``"eps 1e-05"``); "" where it does not."""
+    from .settings import Args
+
+    defaults = Args()
+    return ", ".join(f"{key} {config[key]:g}" for key in LEARNER_KEYS if config[key] != getattr(defaults, key))
 
 
 def flags(config: dict, keys) -> str:
@@ -43,7 +58,8 @@ def flags(config: dict, keys) -> str:
     words = []
     for key in keys:
         value, flag = setting_of(config, key), "--" + key.replace("_", "-")
-        words.append((flag if value else f"--no-{flag[2:]}") if isinstance(value, bool) else f"{flag} {value}")
+        words.append((flag if value else f"--no-{flag[2:]}") if isinstance(value, bool)
+                     else f"{flag} {shlex.quote(str(value))}")
     return " ".join(words)
 
 
@@ -64,8 +80,8 @@ def save(directory: pathlib.Path, state: dict, step: int, keep: int) -> pathlib.
     return path
 
 
-def load(path: pathlib.Path, config: dict | None = None) -> dict:
-    """Reads a checkpoint; checks it against ``config`` (the loading run's settings) if given."""
+def load(path: pathlib.Path, config: dict | None = None, keys: tuple[str, ...] = IDENTITY_KEYS) -> dict:
+    """Reads a checkpoint; checks it against ``config`` (the loading run's settings) on ``keys`` if given."""
     if not pathlib.Path(path).is_file():
         raise CheckpointError(f"no checkpoint at {path}: pass one of the run's checkpoints/step_*.pt")
     try:
@@ -79,7 +95,7 @@ def load(path: pathlib.Path, config: dict | None = None) -> dict:
     if missing:
         raise CheckpointError(f"{path} is not an mjmaze A2C checkpoint (missing {sorted(missing)}); it was left untouched.")
     if config is not None:
-        differ = identity_differences(state["config"], config)
+        differ = identity_differences(state["config"], config, keys)
         if differ:
             detail = ", ".join(f"{k}: checkpoint {a!r} vs now {b!r}" for k, (a, b) in differ.items())
             raise CheckpointError(f"{path} belongs to a different run ({detail}); it was left untouched. To go on "

@@ -79,10 +79,11 @@ def evaluate_checkpoints(run_dir: pathlib.Path, num_envs: int = 16,
 
 def group_key(config: dict) -> tuple:
     """What makes runs seeds of one curve: the scenario, its difficulty, the number of training configurations,
-    and what the agent saw (head-bob, flashes; runs saved before they existed ran without; the engine)."""
+    and what the agent saw (head-bob, flashes; runs saved before they existed ran without; the engine), and the
+    learner's settings (RMSprop eps 1e-5 before 2026-11-29)."""
     return (config["scenario"], config.get("size"), config.get("num_items"), config.get("complexity"),
             config.get("num_configs"), checkpoint.setting_of(config, "head_bob"), checkpoint.setting_of(config, "flashes"),
-            checkpoint.setting_of(config, "engine"))
+            checkpoint.setting_of(config, "engine"), *(config.get(key) for key in checkpoint.LEARNER_KEYS))
 
 
 def setting(config: dict) -> str:
@@ -95,11 +96,13 @@ def setting(config: dict) -> str:
 
 
 def label(config: dict) -> str:
-    """The setting, and what set this group's frames apart (no head-bob, no flashes, ViZDoom's engine)."""
+    """The setting, and what set this group apart (no head-bob, no flashes, ViZDoom's engine, another learner)."""
     missing = [name for key, name in (("head_bob", "head-bob"), ("flashes", "flashes"))
                if not checkpoint.setting_of(config, key)]
     engine = " on ViZDoom" if checkpoint.setting_of(config, "engine") == "vizdoom" else ""
-    return setting(config) + engine + (f" (no {', no '.join(missing)})" if missing else "")
+    learner = checkpoint.learner_label(config) if all(key in config for key in checkpoint.LEARNER_KEYS) else ""
+    return (setting(config) + engine + (f" (no {', no '.join(missing)})" if missing else "")
+            + (f" [{learner}]" if learner else ""))
 
 
 def first_time_limit(config: dict) -> int:

@@ -64,11 +64,16 @@ def env_id(config: dict) -> str | None:
     return Args.from_config(config).env_id()
 
 
-def learner_label(learner: dict) -> str:
-    """How a record's learner differs from today's defaults (``"eps 1e-05"``); "" where it does not. Runs
-    of two learners are two curves: the table and plots keep them apart."""
-    defaults = Args()
-    return ", ".join(f"{key} {value:g}" for key, value in learner.items() if value != getattr(defaults, key))
+def learner_key(learner: dict | None = None) -> tuple:
+    """A learner's settings (:data:`checkpoint.LEARNER_KEYS`; None: today's defaults) as one comparable value:
+    runs of two learners are two curves, which the table and plots keep apart."""
+    learner = learner or {key: getattr(Args(), key) for key in checkpoint.LEARNER_KEYS}
+    return tuple(learner[key] for key in checkpoint.LEARNER_KEYS)
+
+
+def learner_label(key: tuple) -> str:
+    """:func:`learner_key`'s settings that differ from today's, to read (``"eps 1e-05"``; "" for today's)."""
+    return checkpoint.learner_label(dict(zip(checkpoint.LEARNER_KEYS, key)))
 
 
 def run_record(run_dir: pathlib.Path) -> dict:
@@ -113,8 +118,8 @@ def read_data(path: pathlib.Path = DATA, learners: bool = True) -> dict:
 
 
 def groups(data: dict) -> list[tuple[str, str]]:
-    """The ``(setting, learner label)`` pairs the data holds: one curve pair, one table block, one plot each."""
-    return sorted({(r["setting"], learner_label(r["learner"])) for r in data["runs"]})
+    """The ``(setting, learner key)`` pairs the data holds: one curve pair, one table block, one plot each."""
+    return sorted({(r["setting"], learner_key(r["learner"])) for r in data["runs"]})
 
 
 def add(run_dirs: list[pathlib.Path], path: pathlib.Path = DATA) -> dict:
@@ -123,7 +128,7 @@ def add(run_dirs: list[pathlib.Path], path: pathlib.Path = DATA) -> dict:
 
     def same_run(a: dict, b: dict) -> bool:  # a record without its learner's settings is replaced by its run's
         return ((a["setting"], a["env_id"], a["seed"]) == (b["setting"], b["env_id"], b["seed"])
-                and ("learner" not in a or learner_label(a["learner"]) == learner_label(b["learner"])))
+                and ("learner" not in a or learner_key(a["learner"]) == learner_key(b["learner"])))
 
     for run_dir in run_dirs:
         record = run_record(pathlib.Path(run_dir))
@@ -178,12 +183,12 @@ def greedy_test_at(records: list[dict], step: int) -> str:
     return f"{np.mean(values):.4g}" if values else "–"
 
 
-def engine_records(data: dict, setting: str, engine: str, learner: str = "") -> list[dict]:
-    """One engine's records of a setting under one learner (:func:`learner_label`), its seeds; records of one
+def engine_records(data: dict, setting: str, engine: str, learner: tuple | None = None) -> list[dict]:
+    """One engine's records of a setting under one learner (:func:`learner_key`; None: today's), its seeds; records of one
     engine under two env ids (ViZDoom's frames resized two ways, mjmaze's scenario at two versions) are not
     seeds of one curve: an error."""
     records = [r for r in data["runs"] if r["setting"] == setting and r["engine"] == engine
-               and learner_label(r["learner"]) == learner]
+               and learner_key(r["learner"]) == (learner or learner_key())]
     ids = sorted({r["env_id"] for r in records})
     if len(ids) > 1:
         raise ValueError(f"{setting} on {engine} holds runs of {ids}: keep one env id in {DATA.name} per engine")
@@ -201,7 +206,8 @@ def table(data: dict) -> str:
         scenario = setting.rpartition("_")[0]
         units, digits = published.curve_units(scenario), published.of(scenario).metric_digits
         by_engine = {engine: engine_records(data, setting, engine, learner) for engine in ENGINE_NAMES}
-        name = f"{setting} ({learner})" if learner else setting
+        label = learner_label(learner)
+        name = f"{setting} ({label})" if label else setting
         for step, level in paper_levels(setting):
             cells, reached = [], {}
             for engine, records in by_engine.items():
@@ -234,12 +240,13 @@ def _ratio(reached: dict) -> str:
     return "neither yet"
 
 
-def plot_name(setting: str, learner: str) -> str:
+def plot_name(setting: str, learner: tuple | None = None) -> str:
     """``engines_<setting>.png``; a learner other than today's adds its settings (``_eps1e-05``)."""
-    return f"engines_{setting}" + (f"_{learner.replace(', ', '_').replace(' ', '')}" if learner else "") + ".png"
+    label = learner_label(learner or learner_key())
+    return f"engines_{setting}" + (f"_{label.replace(', ', '_').replace(' ', '')}" if label else "") + ".png"
 
 
-def figure(data: dict, setting: str, learner: str = ""):
+def figure(data: dict, setting: str, learner: tuple | None = None):
     """Both engines' training curves (mean over seeds, each seed thin) and greedy test evaluations, and the paper's points."""
     from matplotlib.figure import Figure
 
@@ -266,7 +273,8 @@ def figure(data: dict, setting: str, learner: str = ""):
              if s <= max(reach * 1.5, LEVEL_STEPS[0])]
     if paper:
         ax.plot(*zip(*paper), color="black", marker="s", linestyle=":", label="the paper (read off its plots)")
-    ax.set_title(f"{setting}: one A2C on both engines" + (f" ({learner})" if learner else ""), fontsize=10)
+    label = learner_label(learner or learner_key())
+    ax.set_title(f"{setting}: one A2C on both engines" + (f" ({label})" if label else ""), fontsize=10)
     ax.set_xlabel("agent steps (observations)")
     ax.set_ylabel(published.curve_units(scenario))
     ax.grid(alpha=0.3)
@@ -278,8 +286,10 @@ def draw(data: dict, docs: pathlib.Path = DOCS, page: pathlib.Path | None = LEAR
     """Writes each setting's plot into ``docs`` and the table into ``page`` (between its markers); returns the plots."""
     written = [save_figure(figure(data, setting, learner), docs / plot_name(setting, learner))
                for setting, learner in groups(data)]
-    for stale in set(docs.glob("engines_*.png")) - set(written):  # a group the data no longer holds
-        stale.unlink()
+    settings = {setting for setting, _ in groups(data)}
+    for stale in set(docs.glob("engines_*.png")) - set(written):  # a learner's plot the data no longer holds
+        if any(stale.name == f"engines_{s}.png" or stale.name.startswith(f"engines_{s}_") for s in settings):
+            stale.unlink()
     if page is not None:
         text = page.read_text()
         if TABLE_START not in text or TABLE_END not in text:

@@ -59,7 +59,7 @@ def load_run(run_dir: str | pathlib.Path, checkpoint_path: str | pathlib.Path | 
         if not found:
             raise FileNotFoundError(f"no checkpoint in {run_dir / 'checkpoints'}")
         checkpoint_path = found[-1]
-    state = checkpoint.load(pathlib.Path(checkpoint_path), dataclasses.asdict(args))
+    state = checkpoint.load(pathlib.Path(checkpoint_path), dataclasses.asdict(args), checkpoint.PLAY_KEYS)
     state["path"] = str(checkpoint_path)
     agent = new_agent(args.scenario, args.task_kwargs()).to(device)
     agent.load_state_dict(state["model"])

@@ -129,7 +129,8 @@ def check_same_run(run_dir: pathlib.Path, config: dict) -> None:
     differ = checkpoint.identity_differences(saved, config)
     if differ:
         detail = ", ".join(f"{k}: saved {a!r} vs now {b!r}" for k, (a, b) in differ.items())
-        raise ValueError(f"{run_dir} holds a run with other settings ({detail}); "
+        go_on = f"pass {checkpoint.flags(saved, ['eps'])} to go on with it, " if set(differ) == {"eps"} else ""
+        raise ValueError(f"{run_dir} holds a run with other settings ({detail}); {go_on}"
                          "move it aside (nothing was changed) or pass --name for a new sweep folder")
 
 
@@ -221,6 +222,8 @@ def main(argv: list[str] | None = None) -> None:
                         help=f"agent steps per run (default: {DEFAULT_STEPS})")
     parser.add_argument("--num-envs", type=int, default=Args.num_envs)
     parser.add_argument("--num-steps", type=int, default=Args.num_steps)
+    parser.add_argument("--eps", type=float, default=Args.eps,
+                        help="RMSprop epsilon (default: as released; sweeps before 2026-11-29 ran 1e-05)")
     parser.add_argument("--checkpoint-every", type=int, default=None, help="default: total steps / 20")
     parser.add_argument("--keep-checkpoints", type=int, default=None,
                         help="checkpoints kept per run (default: every one for --grid evidence, whose curves "
@@ -250,7 +253,8 @@ def main(argv: list[str] | None = None) -> None:
         specs = [dataclasses.replace(spec, total_steps=None) for spec in specs]
     total_steps = args.total_steps or DEFAULT_STEPS[args.grid]
     settings = {
-        "total_steps": total_steps, "num_envs": args.num_envs, "num_steps": args.num_steps, "device": args.device,
+        "total_steps": total_steps, "num_envs": args.num_envs, "num_steps": args.num_steps, "eps": args.eps,
+        "device": args.device,
         "checkpoint_every": args.checkpoint_every or max(args.num_envs * args.num_steps, total_steps // 20),
         "keep_checkpoints": args.keep_checkpoints or (KEEP_EVERY_CHECKPOINT if args.grid == "evidence" else Args.keep_checkpoints),
         # The training process steps a share of the envs itself: one worker fewer than the run's CPUs.

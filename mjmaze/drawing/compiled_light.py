@@ -101,5 +101,5 @@ def _compiled():
 def light(frames: np.ndarray, inverse_depth: np.ndarray, eye: np.ndarray, cos: np.ndarray, sin: np.ndarray,
           constants: tuple, out: np.ndarray) -> None:
     """Writes ``frames`` (uint8 ``(B, H, W, 3)``) in Doom's light into ``out``; the other arrays and
-    ``constants`` (float32, :meth:`mjmaze.drawing.look.DoomLight._compiled_constants`) as the numpy path has them."""
+    ``constants`` (float32, :meth:`mjmaze.drawing.look.DoomLight._constants`) as the numpy path has them."""
     _compiled()(frames, inverse_depth, eye, cos, sin, *constants, out)

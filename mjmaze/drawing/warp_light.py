@@ -5,8 +5,10 @@ launched from Python, most over every pixel); these kernels make two: one
 thread per column finds its wall, one per pixel lights it. The arithmetic is
 :mod:`mjmaze.drawing.compiled_light`'s (the CPU's), in float32 and the same
 order, so Warp's CPU device gives the CPU's frames bit for bit
-(``tests/test_look.py``); a GPU may fuse a multiply and an add (a grey level
-at most). Imported by :class:`~mjmaze.drawing.look.DoomLight` only for torch
+(``tests/test_warp.py``). A GPU may fuse a multiply and an add (NVRTC's
+default): where a point lies within rounding of a wall face, a pixel or a
+column's wall can then take another surface's gains (the torch passes it
+replaces fused nothing); bench/gpu.py's ``frames`` section measures it. Imported by :class:`~mjmaze.drawing.look.DoomLight` only for torch
 frames: only the Warp backend draws those, so Warp is installed.
 """
 
@@ -87,7 +89,7 @@ def _pixels(frames: wp.array4d(dtype=wp.uint8), inverse_depth: wp.array3d(dtype=
 class WarpLight:
     """:class:`~mjmaze.drawing.look.DoomLight`'s tables on ``device``, and its light of torch frames there.
 
-    ``constants``: what ``DoomLight._compiled_constants`` gives (numpy; the same for both ways of lighting).
+    ``constants``: what ``DoomLight._constants`` gives (numpy; the same for both ways of lighting).
     """
 
     def __init__(self, constants: tuple, device):
@@ -115,7 +117,7 @@ class WarpLight:
         them as a Warp graph of their own when it captures a step (:class:`mjmaze.backends.warp.MazeBatchEnv`).
         """
         batch, height, width, _ = frames.shape
-        out = torch.empty_like(frames)
+        out = torch.empty(frames.shape, dtype=torch.uint8, device=frames.device)  # contiguous, as Warp writes it
         wall_start = torch.empty((batch, width), dtype=torch.int32, device=frames.device)
         wall_limit = torch.empty((batch, width), dtype=torch.float32, device=frames.device)
         right, up, below, gains, flat_start = self._tables
