@@ -91,17 +91,19 @@ def test_runs_of_one_engine_under_two_env_ids_are_kept_apart_and_not_averaged(tm
 
 
 def test_runs_of_two_learners_are_two_curves_each_named_by_its_settings(tmp_path):
-    # Runs saved before 2026-11-29 trained with RMSprop eps 1e-5; today's learner uses 1e-8, as released.
+    # The default learner (RMSprop eps 1e-5) and the released one (--eps 1e-8).
     data_file = tmp_path / "engines.json"
-    data = engines.add([write_run(tmp_path / "old", "mjmaze", 0, np.full(12, 440.0), eps=1e-5),
-                        write_run(tmp_path / "new", "mjmaze", 0, np.full(12, 470.0)),
-                        write_run(tmp_path / "v", "vizdoom", 0, np.full(12, 450.0), eps=1e-5)], data_file)
+    data = engines.add([write_run(tmp_path / "released", "mjmaze", 0, np.full(12, 440.0), eps=1e-8),
+                        write_run(tmp_path / "default", "mjmaze", 0, np.full(12, 470.0)),
+                        write_run(tmp_path / "v", "vizdoom", 0, np.full(12, 450.0), eps=1e-8)], data_file)
     assert len(data["runs"]) == 3  # the same seed under two learners: two records
     rows = engines.table(data).splitlines()[2:]
-    assert [row.split(" | ")[0] for row in rows] == ["| two_colour_1"] * 3 + ["| two_colour_1 (eps 1e-05)"] * 3
-    assert "not run" in rows[0] and "not run" not in rows[3]  # the ViZDoom run beside the mjmaze run of its learner
+    names = [row.split(" | ")[0] for row in rows]
+    assert sorted(set(names)) == ["| two_colour_1", "| two_colour_1 (eps 1e-08)"] and len(names) == 6
+    default, released = rows[names.index("| two_colour_1")], rows[names.index("| two_colour_1 (eps 1e-08)")]
+    assert "not run" in default and "not run" not in released  # the ViZDoom run beside the mjmaze run of its learner
     plots = engines.draw(data, tmp_path, None)
-    assert sorted(p.name for p in plots) == ["engines_two_colour_1.png", "engines_two_colour_1_eps1e-05.png"]
+    assert sorted(p.name for p in plots) == ["engines_two_colour_1.png", "engines_two_colour_1_eps1e-08.png"]
 
 
 def test_a_data_file_without_the_learners_settings_is_refused(tmp_path):

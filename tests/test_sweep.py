@@ -128,7 +128,7 @@ def test_a_run_folder_with_other_settings_is_refused_and_left_alone(tmp_path):
     run = tmp_path / "evidence" / "labyrinth_size7_s0"
     run.mkdir(parents=True)
     saved = json.dumps({"scenario": "labyrinth", "size": 7, "num_envs": 16, "num_steps": 128,
-                        "flashes": True, "eps": 1e-8})  # before head-bob
+                        "flashes": True})  # before head-bob
     (run / "config.json").write_text(saved)
     with pytest.raises(SystemExit, match="other settings \\(head_bob: saved False vs now True\\); move it aside"):
         sweep.main(["--grid", "evidence", "--only", "labyrinth_size7_s0", "--sweeps-dir", str(tmp_path)])
@@ -136,14 +136,14 @@ def test_a_run_folder_with_other_settings_is_refused_and_left_alone(tmp_path):
     assert not (tmp_path / "evidence" / "sweep.json").exists()
 
 
-def test_a_sweep_of_the_earlier_learner_is_refused_with_the_flag_that_goes_on(tmp_path):
-    # Sweeps before 2026-11-29 trained with RMSprop eps 1e-5: resumed as they are with --eps 1e-05.
+def test_a_sweep_of_another_learner_is_refused_with_the_flag_that_goes_on(tmp_path):
+    # A sweep of the released learner (RMSprop eps 1e-8) goes on as it started with --eps 1e-08.
     run = tmp_path / "evidence" / "labyrinth_size7_s0"
     run.mkdir(parents=True)
     config = {"scenario": "labyrinth", "size": 7, "num_envs": 16, "num_steps": 128, "flashes": True, "head_bob": True,
-              "eps": 1e-5}
+              "eps": 1e-8}
     (run / "config.json").write_text(json.dumps(config))
-    with pytest.raises(SystemExit, match=r"\(eps: saved 1e-05 vs now 1e-08\); pass --eps 1e-05 to go on with it"):
+    with pytest.raises(SystemExit, match=r"\(eps: saved 1e-08 vs now 1e-05\); pass --eps 1e-08 to go on with it"):
         sweep.main(["--grid", "evidence", "--only", "labyrinth_size7_s0", "--sweeps-dir", str(tmp_path)])
 
 

@@ -194,16 +194,16 @@ def test_a_checkpoint_of_another_run_is_refused(tmp_path):
 
 
 def test_a_run_resumed_with_another_learner_is_refused_with_the_flags_that_go_on(tmp_path):
-    # Runs before 2026-11-29 saved RMSprop eps 1e-5; resumed under today's default (1e-8, as released), the
-    # optimizer would reload 1e-5 while config.json said 1e-8: refused, naming the flag that goes on as saved.
-    run = a2c.train(tiny(tmp_path, eps=1e-5))
-    with pytest.raises(checkpoint.CheckpointError, match=r"eps: checkpoint 1e-05 vs now 1e-08.*pass --eps 1e-05"):
+    # A run of the released learner (RMSprop eps 1e-8) resumed without --eps 1e-8 would reload the saved
+    # optimizer's eps while config.json said the default's: refused, naming the flag that goes on as saved.
+    run = a2c.train(tiny(tmp_path, eps=1e-8))
+    with pytest.raises(checkpoint.CheckpointError, match=r"eps: checkpoint 1e-08 vs now 1e-05.*pass --eps 1e-08"):
         a2c.train(tiny(tmp_path, total_steps=64, resume=True))
-    a2c.train(tiny(tmp_path, total_steps=64, resume=True, eps=1e-5))
+    a2c.train(tiny(tmp_path, total_steps=64, resume=True, eps=1e-8))
     config = json.loads((run / "config.json").read_text())
-    assert config["eps"] == 1e-5
+    assert config["eps"] == 1e-8
     # Evaluating a network needs no optimizer: a checkpoint loads whatever the learner's settings say.
-    (run / "config.json").write_text(json.dumps({**config, "eps": 1e-8, "lr": 1e-3}))
+    (run / "config.json").write_text(json.dumps({**config, "eps": 1e-5, "lr": 1e-3}))
     assert policy.load_run(run)[2]["step"] == 64
 
 

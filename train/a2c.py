@@ -14,7 +14,7 @@ the env autoresets in the same step (the returned frame starts the next
 episode, so the GRU memory is wiped there); n-step returns bootstrapped from the
 value of the last frame, cut at every episode end (the time limit included, as
 released); loss = policy + 0.5 * value - 0.001 * entropy; gradient norm clipped
-at 0.5; RMSprop (lr 7e-4, alpha 0.99, eps 1e-8: PyTorch's default, as released). The backward pass runs through
+at 0.5; RMSprop (lr 7e-4, alpha 0.99, eps 1e-5; the released code ran 1e-8: ``--eps 1e-8``). The backward pass runs through
 the rollout's own forward passes (kept, not recomputed: the parameters do not
 change within a rollout).
 """

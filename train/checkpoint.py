@@ -25,7 +25,7 @@ IDENTITY_KEYS = ("scenario", "size", "num_items", "complexity", "num_envs", "num
 PLAY_KEYS = tuple(key for key in IDENTITY_KEYS if key not in LEARNER_KEYS)
 # Settings that runs saved before they existed ran with (ViZDoom's frames: INTER_AREA until 2026-11-29).
 MISSING_MEANS = {"head_bob": False, "flashes": False, "engine": "mjmaze", "freedoom": "paper", "resize": "area",
-                 # Every run saved its learner; a config written by hand without it means the learner until 2026-11-29.
+                 # Every run saved its learner; a config written by hand without it means the default learner.
                  "lr": 7e-4, "alpha": 0.99, "eps": 1e-5, "gamma": 0.99, "value_coef": 0.5, "entropy_coef": 0.001,
                  "max_grad_norm": 0.5}
 # Settings that only the ViZDoom engine reads: an mjmaze run's value means nothing.

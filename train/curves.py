@@ -80,7 +80,7 @@ def evaluate_checkpoints(run_dir: pathlib.Path, num_envs: int = 16,
 def group_key(config: dict) -> tuple:
     """What makes runs seeds of one curve: the scenario, its difficulty, the number of training configurations,
     and what the agent saw (head-bob, flashes; runs saved before they existed ran without; the engine), and the
-    learner's settings (RMSprop eps 1e-5 before 2026-11-29)."""
+    learner's settings (``--eps 1e-8``: the released learner's RMSprop)."""
     return (config["scenario"], config.get("size"), config.get("num_items"), config.get("complexity"),
             config.get("num_configs"), checkpoint.setting_of(config, "head_bob"), checkpoint.setting_of(config, "flashes"),
             checkpoint.setting_of(config, "engine"), *(config.get(key) for key in checkpoint.LEARNER_KEYS))

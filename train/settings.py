@@ -38,9 +38,9 @@ class _RunSettings:
     """RMSprop learning rate"""
     alpha: float = 0.99
     """RMSprop smoothing constant"""
-    eps: float = 1e-8
-    """RMSprop epsilon: PyTorch's default, as the released a2c_agent.py ran it (its --eps 1e-5 is parsed and never
-    passed to RMSprop); runs before 2026-11-29 used 1e-5 (docs/scenarios.md)"""
+    eps: float = 1e-5
+    """RMSprop epsilon. The released a2c_agent.py ran PyTorch's 1e-8 (its --eps 1e-5 is parsed and never passed to
+    RMSprop): --eps 1e-8 trains the released learner; which default is open (docs/scenarios.md)"""
     value_coef: float = 0.5
     """weight of the value loss"""
     entropy_coef: float = 0.001

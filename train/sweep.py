@@ -223,7 +223,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--num-envs", type=int, default=Args.num_envs)
     parser.add_argument("--num-steps", type=int, default=Args.num_steps)
     parser.add_argument("--eps", type=float, default=Args.eps,
-                        help="RMSprop epsilon (default: as released; sweeps before 2026-11-29 ran 1e-05)")
+                        help="RMSprop epsilon (1e-8: the released learner's)")
     parser.add_argument("--checkpoint-every", type=int, default=None, help="default: total steps / 20")
     parser.add_argument("--keep-checkpoints", type=int, default=None,
                         help="checkpoints kept per run (default: every one for --grid evidence, whose curves "
