@@ -15,6 +15,8 @@ import torch
 
 from mjmaze.files import atomic_write
 
+from .settings import Args
+
 PREFIX, SUFFIX = "step_", ".pt"
 # What must agree between a checkpoint and the run that loads it.
 # The learner's settings: a run resumed with others would be two learners' curve under one name.
@@ -26,8 +28,7 @@ PLAY_KEYS = tuple(key for key in IDENTITY_KEYS if key not in LEARNER_KEYS)
 # Settings that runs saved before they existed ran with (ViZDoom's frames: INTER_AREA until 2026-11-29).
 MISSING_MEANS = {"head_bob": False, "flashes": False, "engine": "mjmaze", "freedoom": "paper", "resize": "area",
                  # Every run saved its learner; a config written by hand without it means the default learner.
-                 "lr": 7e-4, "alpha": 0.99, "eps": 1e-5, "gamma": 0.99, "value_coef": 0.5, "entropy_coef": 0.001,
-                 "max_grad_norm": 0.5}
+                 **{key: getattr(Args, key) for key in LEARNER_KEYS}}
 # Settings that only the ViZDoom engine reads: an mjmaze run's value means nothing.
 VIZDOOM_ONLY = ("freedoom", "resize")
 
@@ -47,10 +48,7 @@ def identity_differences(saved: dict, now: dict, keys: tuple[str, ...] = IDENTIT
 def learner_label(config: dict) -> str:
     """How a run's learner (its config's, or a record's ``learner``: :data:`LEARNER_KEYS`) differs from today's
     defaults, for people to read (``"eps 1e-05"``); "" where it does not."""
-    from .settings import Args
-
-    defaults = Args()
-    return ", ".join(f"{key} {config[key]:g}" for key in LEARNER_KEYS if config[key] != getattr(defaults, key))
+    return ", ".join(f"{key} {config[key]:g}" for key in LEARNER_KEYS if config[key] != getattr(Args, key))
 
 
 def flags(config: dict, keys) -> str:
