@@ -6,7 +6,7 @@ import pathlib
 import numpy as np
 import pytest
 
-from mjmaze.train import checkpoint, engines
+from mjmaze.train import checkpoint, engines, published
 from mjmaze.train.settings import Args
 
 
@@ -18,7 +18,8 @@ def write_run(folder, engine, seed, values, scenario="two_colour", complexity=1,
               "env_id": f"{engine}-id", **{key: getattr(defaults, key) for key in checkpoint.LEARNER_KEYS}, **learner}
     (folder / "config.json").write_text(json.dumps(config))
     per_update = engines.BIN_STEPS // updates_per_bin
-    lines = [json.dumps({"step": (i + 1) * per_update, "duration": value})
+    field = published.curve_field(scenario)
+    lines = [json.dumps({"step": (i + 1) * per_update, field: value})
              for i, value in enumerate(np.repeat(values, updates_per_bin))]
     (folder / "metrics.jsonl").write_text("\n".join(lines) + "\n")
     return folder
@@ -61,7 +62,7 @@ def test_the_committed_table_is_the_one_the_data_file_gives():
     data = engines.read_data(pathlib.Path(__file__).parents[1] / engines.DATA)
     page = (pathlib.Path(__file__).parents[1] / engines.LEARNING_PAGE).read_text()
     between = page.split(engines.TABLE_START, 1)[1].split(engines.TABLE_END, 1)[0]
-    assert between.strip() == engines.table(data).strip(), "run python -m mjmaze.train.engines draw"
+    assert between.strip() == engines.tables(data).strip(), "run python -m mjmaze.train.engines draw"
 
 
 def test_the_table_gives_each_engines_greedy_test_value_at_the_papers_step(tmp_path):
@@ -111,3 +112,41 @@ def test_a_data_file_without_the_learners_settings_is_refused(tmp_path):
     data_file.write_text(json.dumps({"bin_steps": engines.BIN_STEPS, "runs": [{"setting": "two_colour_1"}]}))
     with pytest.raises(ValueError, match="add those runs again"):
         engines.read_data(data_file)
+
+
+def released_log(path, evaluations):
+    """A log as the released trainer writes it: per evaluation its mean and its games (numpy 2's float reprs)."""
+    lines = ["Updates 0, num timesteps 2048, FPS (600,), mean/median reward -0.2/-0.2, ..."]
+    for update, steps, rewards, times in evaluations:
+        shown = ", ".join(f"np.float32({r})" for r in rewards)
+        lines += [f"2026/11/29 03:00:00 PM Step: {update}, Iter: {steps:09d} Eval mean reward: {sum(rewards) / 128:.3f}",
+                  f"2026/11/29 03:00:00 PM Step: {update}, Game rewards: [{shown}], Game times: {list(times)}"]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_the_released_trainers_evaluations_are_read_in_the_papers_units(tmp_path):
+    # Labyrinth: a game that found the exit sums +1 less its time penalty; one that did not, at most -0.21.
+    log = released_log(tmp_path / "labyrinth_7.sh_log.txt", [
+        (0, 2048, [-0.21, -0.21, 0.95, -0.05], [2100, 2101, 500, 501]),
+        (1000, 2_050_048, [0.99, 0.97, 0.9, -0.21], [100, 300, 1000, 2101])])
+    data_file = tmp_path / "engines.json"
+    engines.add([write_run(tmp_path / "v", "vizdoom", 0, np.full(10, 60.0), scenario="labyrinth", complexity=None,
+                           size=7, eps=1e-8)], data_file)
+    data = engines.add_released(log, "labyrinth_7", data_file)
+    assert data["released"][0]["evaluations"] == {"2048": 25.0, "2050048": 75.0}
+    rows = engines.released_table(data).splitlines()[2:]
+    assert rows[1].startswith("| labyrinth_7 | 2.05M | 75 | – (its first point: 40.0 at 2.5M) |")
+    # Two-colour: the length in steps, 4 tics each.
+    log = released_log(tmp_path / "tc.txt", [(1000, 2_050_048, [3.5, 1.2], [110, 130])])
+    assert engines.released_record(log, "two_colour_1")["evaluations"] == {"2050048": 480.0}
+    assert engines.paper_at("two_colour_1", 7_500_000) == "615"  # halfway between 530 at 5M and 700 at 10M
+    plots = engines.draw(data, tmp_path, None)
+    assert [p.name for p in plots] == ["engines_labyrinth_7_eps1e-08.png"]
+
+
+def test_a_log_without_the_released_trainers_evaluations_is_refused(tmp_path):
+    log = tmp_path / "train.log"
+    log.write_text("Updates 0, num timesteps 2048, FPS (600,), mean/median reward -0.2/-0.2\n")
+    with pytest.raises(ValueError, match="holds no evaluation"):
+        engines.released_record(log, "labyrinth_7")

@@ -2,6 +2,7 @@
 
     python -m mjmaze.train.engines add runs/two_colour_1_s0 runs/vizdoom_two_colour_1_s0   # into the data file
     python -m mjmaze.train.engines draw       # the plots, and the table in docs/learning.md, from the data file
+    python -m mjmaze.train.engines add-released labyrinth_7 OUT/runs/.../labyrinth_7.sh_log.txt   # the paper's code
 
 ``add`` reads each training run (``--engine mjmaze`` or ``--engine vizdoom``:
 the same A2C, the same settings) and keeps its training curve, in
@@ -13,6 +14,12 @@ points) into ``docs/engines_<setting>.png`` and writes the table of
 observations each engine needs to reach the paper's levels at 2.5M, 5M and
 10M into docs/learning.md between its markers, so that no figure there is
 typed by hand.
+
+``add-released`` reads the log of the paper's own trainer (``tools/released_trainer.py``)
+on one setting: its greedy evaluations of the first 128 test games to finish
+every 1,000 updates, the protocol of the paper's curves. They go into the same
+file, onto the setting's plot and into a second table beside the paper's curve
+and mjmaze's A2C on ViZDoom: which of the three curves a result is held to.
 """
 
 from __future__ import annotations
@@ -21,11 +28,13 @@ import argparse
 import datetime
 import json
 import pathlib
+import re
 import warnings
 
 import numpy as np
 
 from mjmaze import files
+from mjmaze.backends import vizdoom_env
 from mjmaze.game import registry
 
 from . import checkpoint, curves, published
@@ -108,8 +117,9 @@ def read_data(path: pathlib.Path = DATA, learners: bool = True) -> dict:
     """The data file (``learners``: refuse records that predate the learner's settings; :func:`add` takes them,
     to replace them)."""
     if not path.exists():
-        return {"bin_steps": BIN_STEPS, "runs": []}
+        return {"bin_steps": BIN_STEPS, "runs": [], "released": []}
     data = json.loads(path.read_text())
+    data.setdefault("released", [])
     if data.get("bin_steps") != BIN_STEPS:
         raise ValueError(f"{path} holds {data.get('bin_steps')}-step bins, this version {BIN_STEPS}: add the runs again")
     if learners and any("learner" not in r for r in data["runs"]):
@@ -240,6 +250,76 @@ def _ratio(reached: dict) -> str:
     return "neither yet"
 
 
+# The released trainer's log lines (``a2c_agent.evaluate``): ``Step: {update}, Iter: {steps} Eval mean reward: ...``
+# and ``Step: {update}, Game rewards: [...], Game times: [...]``, the first 128 test games to finish.
+_RELEASED_EVAL = re.compile(r"Step: *(\d+), Iter: *(\d+) Eval mean reward")
+_RELEASED_GAMES = re.compile(r"Step: *(\d+), Game rewards: \[(.*?)\], Game times: \[(.*?)\]")
+# numpy 2 writes a list's floats as np.float32(0.5): the numbers inside are what count.
+_NUMBER = re.compile(r"-?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?")
+
+
+def _numbers(text: str) -> list[float]:
+    return [float(n) for n in _NUMBER.findall(re.sub(r"np\.\w+\(", "(", text))]
+
+
+def released_record(log: pathlib.Path, setting: str) -> dict:
+    """The greedy evaluations in a log of the paper's own trainer on ``setting`` (``tools/released_trainer.py``):
+    at each, the mean over its games of the paper's curve field, in the curves' units."""
+    scenario, _, difficulty = setting.rpartition("_")
+    registry.get(scenario)
+    steps_of = {int(update): int(steps) for update, steps in _RELEASED_EVAL.findall(log.read_text())}
+    evaluations = {}
+    for update, rewards, times in _RELEASED_GAMES.findall(log.read_text()):
+        rewards, times = _numbers(rewards), _numbers(times)
+        if int(update) not in steps_of or not rewards or len(rewards) != len(times):
+            raise ValueError(f"{log}: evaluation at update {update} is not a released trainer's (no Iter line, "
+                             "or its rewards and times differ in number)")
+        values = [vizdoom_env.released_game_value(scenario, r, int(t), int(difficulty)) for r, t in zip(rewards, times)]
+        evaluations[str(steps_of[int(update)])] = float(f"{np.mean(values) * published.curve_scale(scenario):.4g}")
+    if not evaluations:
+        raise ValueError(f"{log} holds no evaluation of the released trainer (its 'Game rewards' lines)")
+    return {"setting": setting, "log": log.name, "games": len(rewards), "evaluations": evaluations,
+            "added": datetime.date.today().isoformat()}
+
+
+def add_released(log: pathlib.Path, setting: str, path: pathlib.Path = DATA) -> dict:
+    """Puts a released trainer's evaluations into the data file, replacing an earlier record of the same log."""
+    data = read_data(path, learners=False)
+    record = released_record(pathlib.Path(log), setting)
+    data["released"] = [r for r in data["released"] if (r["setting"], r["log"]) != (setting, record["log"])] + [record]
+    data["released"].sort(key=lambda r: (r["setting"], r["log"]))
+    files.atomic_write_json(path, data)
+    return data
+
+
+def paper_at(setting: str, step: int) -> str:
+    """The paper's curve at ``step``, linear between its points; before its first point, that point."""
+    scenario, _, difficulty = setting.rpartition("_")
+    points = published.of(scenario).curves.get(int(difficulty), ())
+    digits = published.of(scenario).metric_digits
+    if not points:
+        return "–"
+    if step < points[0][0]:
+        return f"– (its first point: {points[0][1]:.{digits}f} at {points[0][0] / 1e6:g}M)"
+    return f"{np.interp(step, *zip(*points)):.{digits}f}"
+
+
+def released_table(data: dict) -> str:
+    """Per evaluation of the paper's own trainer: its greedy test value, the paper's curve there, and mjmaze's
+    A2C on ViZDoom's greedy test value nearest it (each learner's)."""
+    lines = ["| setting | the released trainer's step | its greedy test (first 128 games) | the paper's curve there "
+             "| mjmaze's A2C on ViZDoom, greedy test there |", "|---|---|---|---|---|"]
+    for record in data["released"]:
+        setting = record["setting"]
+        ours = [(learner_label(learner), engine_records(data, setting, "vizdoom", learner))
+                for s, learner in groups(data) if s == setting]
+        for step, value in sorted(record["evaluations"].items(), key=lambda item: int(item[0])):
+            there = "; ".join(f"{greedy_test_at(records, int(step))} ({label or 'default learner'})"
+                              for label, records in ours if records) or "not run"
+            lines.append(f"| {setting} | {int(step) / 1e6:.2f}M | {value:.4g} | {paper_at(setting, int(step))} | {there} |")
+    return "\n".join(lines)
+
+
 def plot_name(setting: str, learner: tuple | None = None) -> str:
     """``engines_<setting>.png``; a learner other than today's adds its settings (``_eps1e-05``)."""
     label = learner_label(learner or learner_key())
@@ -269,6 +349,12 @@ def figure(data: dict, setting: str, learner: tuple | None = None):
         tests = sorted((int(s), v[1]) for r in records for s, v in r["evaluations"].items())
         if tests and published.curve_field(scenario) == registry.get(scenario).metric:
             ax.plot(*zip(*tests), color=colour, marker="x", linestyle="none", label=f"{name}, greedy on test mazes")
+    released = sorted((int(s), v) for r in data.get("released", []) if r["setting"] == setting
+                      for s, v in r["evaluations"].items())
+    if released:
+        ax.plot(*zip(*released), color="C2", marker="D", linestyle="none",
+                label="the paper's code today, greedy (first 128 test games)")
+        reach = max(reach, released[-1][0])
     paper = [(s, v) for s, v in published.of(scenario).curves.get(int(setting.rpartition("_")[2]), ())
              if s <= max(reach * 1.5, LEVEL_STEPS[0])]
     if paper:
@@ -280,6 +366,12 @@ def figure(data: dict, setting: str, learner: tuple | None = None):
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, loc="best")
     return fig
+
+
+def tables(data: dict) -> str:
+    """What goes between the page's markers: :func:`table`, and :func:`released_table` where the data holds runs of
+    the paper's own trainer."""
+    return table(data) + (f"\n\n{released_table(data)}" if data["released"] else "")
 
 
 def draw(data: dict, docs: pathlib.Path = DOCS, page: pathlib.Path | None = LEARNING_PAGE) -> list[pathlib.Path]:
@@ -296,7 +388,7 @@ def draw(data: dict, docs: pathlib.Path = DOCS, page: pathlib.Path | None = LEAR
             raise ValueError(f"{page} has no {TABLE_START} ... {TABLE_END} markers for the table")
         head, rest = text.split(TABLE_START, 1)
         tail = rest.split(TABLE_END, 1)[1]
-        files.atomic_write_bytes(page, f"{head}{TABLE_START}\n{table(data)}\n{TABLE_END}{tail}".encode())
+        files.atomic_write_bytes(page, f"{head}{TABLE_START}\n{tables(data)}\n{TABLE_END}{tail}".encode())
     return written
 
 
@@ -305,22 +397,28 @@ def main(argv: list[str] | None = None) -> None:
     commands = parser.add_subparsers(dest="command", required=True)
     adding = commands.add_parser("add", help="put runs' curves into the data file")
     adding.add_argument("runs", nargs="+", type=pathlib.Path, help="training run folders (either engine)")
+    releasing = commands.add_parser("add-released", help="put the paper's own trainer's evaluations into the data file")
+    releasing.add_argument("setting", help="the setting it trained, e.g. labyrinth_7")
+    releasing.add_argument("log", type=pathlib.Path, help="its log (OUT/runs/tmp/results/.../<name>_log.txt)")
     drawing = commands.add_parser("draw", help="the plots and docs/learning.md's table from the data file")
     drawing.add_argument("--docs", type=pathlib.Path, default=DOCS, help="where the plots go (default docs/)")
     drawing.add_argument("--page", type=pathlib.Path, default=LEARNING_PAGE,
                          help="the page whose table is rewritten (default docs/learning.md)")
-    for sub in (adding, drawing):
+    for sub in (adding, releasing, drawing):
         sub.add_argument("--data", type=pathlib.Path, default=DATA, help=f"the data file (default {DATA})")
     args = parser.parse_args(argv)
     try:
         if args.command == "add":
             data = add(args.runs, args.data)
             print(f"{len(args.runs)} run(s) into {args.data} ({len(data['runs'])} in all)")
+        elif args.command == "add-released":
+            data = add_released(args.log, args.setting, args.data)
+            print(f"the released trainer's evaluations of {args.setting} into {args.data}")
         else:
             data = read_data(args.data)
             for path in draw(data, args.docs, args.page):
                 print(f"written: {path}")
-            print(table(data))
+            print(tables(data))
     except (checkpoint.CheckpointError, FileNotFoundError, ValueError) as error:
         raise SystemExit(f"error: {error}") from None
 

@@ -227,6 +227,25 @@ def episode_metrics(scenario: str, rewards: Sequence[float], steps: int, difficu
     raise ValueError(f"the paper released no {scenario!r} mazes")
 
 
+def released_game_value(scenario: str, total_reward: float, steps: int, difficulty: int) -> float:
+    """One game's value of the paper's curve field (:func:`mjmaze.train.published.curve_field`, unscaled) from what
+    the released trainer's log keeps of it: its summed reward and its length in steps.
+
+    The log holds no per-step rewards, so the paid goals are told apart by the sum: a time penalty of
+    0.0001 a step is at most 0.21 over 2,100 steps, and Two-colour's duration needs only the length
+    (the released ``Scorer`` counts one step more for an env's games after its first: 4 tics).
+    """
+    if scenario == "labyrinth":  # the exit's +1, or nothing: > 0.79 or <= 0
+        return float(total_reward > 0.5)
+    if scenario == "find_return":  # both +0.5: > 0.79; the pillar alone: <= 0.5
+        return float(total_reward > 0.75)
+    if scenario == "k_item":  # the paper's unit: the return over its maximum, K x 0.5
+        return float(total_reward) / (0.5 * difficulty)
+    if scenario == "two_colour":
+        return float(steps * TICS_PER_STEP)
+    raise ValueError(f"the paper released no {scenario!r} mazes")
+
+
 def _exit_on_sigterm(signum, frame):
     raise SystemExit(0)
 
