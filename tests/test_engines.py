@@ -128,8 +128,8 @@ def released_log(path, evaluations):
 def test_the_released_trainers_evaluations_are_read_in_the_papers_units(tmp_path):
     # Labyrinth: a game that found the exit sums +1 less its time penalty; one that did not, at most -0.21.
     log = released_log(tmp_path / "labyrinth_7.sh_log.txt", [
-        (0, 2048, [-0.21, -0.21, 0.95, -0.05], [2100, 2101, 500, 501]),
-        (1000, 2_050_048, [0.99, 0.97, 0.9, -0.21], [100, 300, 1000, 2101])])
+        (0, 2048, [-0.21, -0.21, 0.95, -0.05], [525, 526, 125, 500]),
+        (1000, 2_050_048, [0.99, 0.97, 0.9, -0.21], [25, 75, 250, 526])])
     data_file = tmp_path / "engines.json"
     engines.add([write_run(tmp_path / "v", "vizdoom", 0, np.full(10, 60.0), scenario="labyrinth", complexity=None,
                            size=7, eps=1e-8)], data_file)
@@ -143,6 +143,9 @@ def test_the_released_trainers_evaluations_are_read_in_the_papers_units(tmp_path
     assert engines.paper_at("two_colour_1", 7_500_000) == "615"  # halfway between 530 at 5M and 700 at 10M
     plots = engines.draw(data, tmp_path, None)
     assert [p.name for p in plots] == ["engines_labyrinth_7_eps1e-08.png"]
+    # A setting the released trainer ran and no learner here: its own plot, with the paper's points.
+    data = engines.add_released(log, "two_colour_1", data_file)
+    assert [p.name for p in engines.draw(data, tmp_path, None)][-1] == "engines_two_colour_1.png"
 
 
 def test_a_log_without_the_released_trainers_evaluations_is_refused(tmp_path):

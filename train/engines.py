@@ -309,13 +309,17 @@ def released_table(data: dict) -> str:
     A2C on ViZDoom's greedy test value nearest it (each learner's)."""
     lines = ["| setting | the released trainer's step | its greedy test (first 128 games) | the paper's curve there "
              "| mjmaze's A2C on ViZDoom, greedy test there |", "|---|---|---|---|---|"]
-    for record in data["released"]:
+    for record in data.get("released", []):
         setting = record["setting"]
+        scenario = setting.rpartition("_")[0]
+        # evaluate's value is the scenario's metric: beside the paper's curve field only where they are one
+        same_unit = published.curve_field(scenario) == registry.get(scenario).metric
         ours = [(learner_label(learner), engine_records(data, setting, "vizdoom", learner))
                 for s, learner in groups(data) if s == setting]
         for step, value in sorted(record["evaluations"].items(), key=lambda item: int(item[0])):
             there = "; ".join(f"{greedy_test_at(records, int(step))} ({label or 'default learner'})"
                               for label, records in ours if records) or "not run"
+            there = there if same_unit else "– (another unit)"
             lines.append(f"| {setting} | {int(step) / 1e6:.2f}M | {value:.4g} | {paper_at(setting, int(step))} | {there} |")
     return "\n".join(lines)
 
@@ -371,14 +375,17 @@ def figure(data: dict, setting: str, learner: tuple | None = None):
 def tables(data: dict) -> str:
     """What goes between the page's markers: :func:`table`, and :func:`released_table` where the data holds runs of
     the paper's own trainer."""
-    return table(data) + (f"\n\n{released_table(data)}" if data["released"] else "")
+    return table(data) + (f"\n\n{released_table(data)}" if data.get("released") else "")
 
 
 def draw(data: dict, docs: pathlib.Path = DOCS, page: pathlib.Path | None = LEARNING_PAGE) -> list[pathlib.Path]:
     """Writes each setting's plot into ``docs`` and the table into ``page`` (between its markers); returns the plots."""
+    # The released trainer's points go on each learner's plot of their setting, and make one where no run is.
+    plots = groups(data) + [(s, None) for s in sorted({r["setting"] for r in data.get("released", [])}
+                                                      - {setting for setting, _ in groups(data)})]
     written = [save_figure(figure(data, setting, learner), docs / plot_name(setting, learner))
-               for setting, learner in groups(data)]
-    settings = {setting for setting, _ in groups(data)}
+               for setting, learner in plots]
+    settings = {setting for setting, _ in plots}
     for stale in set(docs.glob("engines_*.png")) - set(written):  # a learner's plot the data no longer holds
         if any(stale.name == f"engines_{s}.png" or stale.name.startswith(f"engines_{s}_") for s in settings):
             stale.unlink()

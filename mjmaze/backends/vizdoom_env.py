@@ -231,9 +231,12 @@ def released_game_value(scenario: str, total_reward: float, steps: int, difficul
     """One game's value of the paper's curve field (:func:`mjmaze.train.published.curve_field`, unscaled) from what
     the released trainer's log keeps of it: its summed reward and its length in steps.
 
-    The log holds no per-step rewards, so the paid goals are told apart by the sum: a time penalty of
-    0.0001 a step is at most 0.21 over 2,100 steps, and Two-colour's duration needs only the length
-    (the released ``Scorer`` counts one step more for an env's games after its first: 4 tics).
+    The log holds no per-step rewards, so the paid goals are told apart by the sum: the cfgs' time penalty
+    of 0.0001 a tic is at most 0.21 over 2,100 tics, and evaluation pays no ``_check_health`` bonus (train
+    envs only). Two-colour's duration needs only the length (the released ``Scorer`` counts one step more
+    for an env's games after its first: 4 tics). As released, an evaluation's envs go on with the games a
+    previous one left unfinished (``--fixed_scenario`` resets one env in 16): those games, counted from
+    where they resumed, finish first and are among the 128. The log cannot tell them apart.
     """
     if scenario == "labyrinth":  # the exit's +1, or nothing: > 0.79 or <= 0
         return float(total_reward > 0.5)
