@@ -153,3 +153,17 @@ def test_a_log_without_the_released_trainers_evaluations_is_refused(tmp_path):
     log.write_text("Updates 0, num timesteps 2048, FPS (600,), mean/median reward -0.2/-0.2\n")
     with pytest.raises(ValueError, match="holds no evaluation"):
         engines.released_record(log, "labyrinth_7")
+
+
+def test_a_last_bin_the_run_barely_entered_is_left_out(tmp_path):
+    # A run stopped one update past 2.5M: that update's few episodes are no bin's mean (they drew a cliff).
+    run = write_run(tmp_path / "m", "mjmaze", 0, np.full(10, 450.0))
+    with (run / "metrics.jsonl").open("a") as metrics:
+        metrics.write(json.dumps({"step": 10 * engines.BIN_STEPS + 2048, "duration": 100.0}) + "\n")
+    record = engines.run_record(run)
+    assert len(record["train"]) == 10 and set(record["train"]) == {450.0}
+    assert record["steps"] == 10 * engines.BIN_STEPS + 2048
+    # A last bin reached more than half way stays.
+    with (run / "metrics.jsonl").open("a") as metrics:
+        metrics.write(json.dumps({"step": 10 * engines.BIN_STEPS + 200_000, "duration": 500.0}) + "\n")
+    assert len(engines.run_record(run)["train"]) == 11

@@ -94,6 +94,10 @@ def run_record(run_dir: pathlib.Path) -> dict:
     if config.get("num_configs") is not None:
         raise ValueError(f"{run_dir} trained on {config['num_configs']} configurations: the paper's curves are of 256")
     kept = run["steps"] >= curves.first_time_limit(config)
+    # A last bin the run reached less than half of holds a few updates' episodes (often one, often none
+    # finished): its mean is noise, drawn as a cliff at the curve's end. It stays out.
+    last_step = int(run["steps"].max())
+    kept &= (run["steps"] - 1) // BIN_STEPS < (last_step + BIN_STEPS // 2) // BIN_STEPS
     which = (run["steps"][kept] - 1) // BIN_STEPS
     bins = int(which.max()) + 1 if len(which) else 0
     sums = np.bincount(which, weights=run["values"][kept], minlength=bins)
@@ -105,7 +109,7 @@ def run_record(run_dir: pathlib.Path) -> dict:
         "env_id": env_id(config),
         "learner": {key: config[key] for key in checkpoint.LEARNER_KEYS},
         "field": published.curve_field(config["scenario"]),
-        "steps": int(run["steps"].max()),
+        "steps": last_step,
         # Each bin's mean of the updates' training means (None where no episode ended), 4 significant digits.
         "train": [float(f"{v:.4g}") if c else None for v, c in zip(sums / np.maximum(counts, 1), counts)],
         "evaluations": {str(step): [float(f"{a:.4g}"), float(f"{b:.4g}")] for step, (a, b) in sorted(run["evals"].items())},
