@@ -20,7 +20,9 @@ released trainer"):
 Kept as released: ``cv2.resize(obs, size, cv2.INTER_AREA)`` (bilinear: the flag
 is OpenCV's ``dst``). Its ``--num_frames`` counts agent steps; evaluations (128
 greedy test games) every 1000 updates (2.05M steps) go to the log's
-``Eval mean reward`` and ``Game times`` lines.
+``Eval mean reward`` and ``Game times`` lines, which
+``python -m mjmaze.train.engines add-released SETTING LOG`` puts beside both
+engines' curves.
 """
 
 from __future__ import annotations
