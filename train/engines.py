@@ -187,6 +187,12 @@ def _millions(steps: int | None, last: int) -> str:
     return f"{steps / 1e6:.2f}M" if steps is not None else f"> {last / 1e6:.2f}M"
 
 
+def greedy_in_curve_units(scenario: str) -> bool:
+    """Whether ``evaluate``'s value (the scenario's metric) is in the paper's curves' units (K-item's is not:
+    items in order / K against the return over its maximum)."""
+    return published.curve_field(scenario) == registry.get(scenario).metric
+
+
 def greedy_test_at(records: list[dict], step: int) -> str:
     """The seeds' mean greedy test value at the evaluation nearest ``step`` (within :data:`BIN_STEPS`), or "–"."""
     values = []
@@ -271,9 +277,10 @@ def released_record(log: pathlib.Path, setting: str) -> dict:
     at each, the mean over its games of the paper's curve field, in the curves' units."""
     scenario, _, difficulty = setting.rpartition("_")
     registry.get(scenario)
-    steps_of = {int(update): int(steps) for update, steps in _RELEASED_EVAL.findall(log.read_text())}
+    text = log.read_text()
+    steps_of = {int(update): int(steps) for update, steps in _RELEASED_EVAL.findall(text)}
     evaluations = {}
-    for update, rewards, times in _RELEASED_GAMES.findall(log.read_text()):
+    for update, rewards, times in _RELEASED_GAMES.findall(text):
         rewards, times = _numbers(rewards), _numbers(times)
         if int(update) not in steps_of or not rewards or len(rewards) != len(times):
             raise ValueError(f"{log}: evaluation at update {update} is not a released trainer's (no Iter line, "
@@ -316,8 +323,7 @@ def released_table(data: dict) -> str:
     for record in data.get("released", []):
         setting = record["setting"]
         scenario = setting.rpartition("_")[0]
-        # evaluate's value is the scenario's metric: beside the paper's curve field only where they are one
-        same_unit = published.curve_field(scenario) == registry.get(scenario).metric
+        same_unit = greedy_in_curve_units(scenario)
         ours = [(learner_label(learner), engine_records(data, setting, "vizdoom", learner))
                 for s, learner in groups(data) if s == setting]
         for step, value in sorted(record["evaluations"].items(), key=lambda item: int(item[0])):
@@ -355,7 +361,7 @@ def figure(data: dict, setting: str, learner: tuple | None = None):
         seeds = ", ".join(str(r["seed"]) for r in records)
         ax.plot(x, mean, color=colour, linewidth=2, label=f"{name}, training episodes (seed {seeds})")
         tests = sorted((int(s), v[1]) for r in records for s, v in r["evaluations"].items())
-        if tests and published.curve_field(scenario) == registry.get(scenario).metric:
+        if tests and greedy_in_curve_units(scenario):
             ax.plot(*zip(*tests), color=colour, marker="x", linestyle="none", label=f"{name}, greedy on test mazes")
     released = sorted((int(s), v) for r in data.get("released", []) if r["setting"] == setting
                       for s, v in r["evaluations"].items())
