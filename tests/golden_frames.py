@@ -33,9 +33,10 @@ SETTINGS = {
 #: Two envs per scenario, seeded as a vector env of two reset with these seeds seeds its envs.
 SEEDS = (0, 1)
 STEPS = 120
-#: The steps whose frames are kept (0 is the reset's): Two-colour's scripts flash at 7, 14, 49 and 63
-#: (its damage every 8 steps, a pickup) and restart after 94 (env 1).
-KEPT = (0, 7, 14, 28, 49, 63, 84, 95, 112)
+#: The steps whose frames are kept (0 is the reset's): Two-colour's floor flashes red at 0 and 112 (every
+#: 8 steps from the first frame's hit), at 49 under a pickup's gold (env 0), and env 1 dies at 96 and
+#: starts anew at 97, flashed again.
+KEPT = (0, 7, 14, 28, 49, 63, 84, 97, 112)
 # Actions 0-4: turn left, turn right, forward, forward+left, forward+right (mjmaze.game.core.ACTION_NAMES): a
 # forward key 40% of the steps and turning right 55%, so the agent walks (head-bob), turns, meets walls and
 # reaches items. (Fixed with the reference frames: other weights would need a re-record.)

@@ -59,12 +59,23 @@ def test_the_opacities_are_zdooms():
     assert look.tint(np, frame, rgb[0], alpha[0])[0, 0].tolist() == pytest.approx([58, 17, 11], abs=1)
 
 
+def test_the_first_frame_is_flashed_by_the_floors_hit_on_its_tic():
+    # The released Two-colour cfgs set no start time: ViZDoom's first frame shows a hit's red at count 7
+    # (python tools/two_colour_engines.py CHECKOUT --lava), as after a hit on a step's last tic.
+    envs = [mjmaze.load("two_colour", task_kwargs={"random": 0, "flashes": flashes, "complexity": 1})
+            for flashes in (True, False)]
+    flashed, plain = (env.reset().observation["pixels"].astype(int) for env in envs)
+    assert counts(envs[0]) == (two_colour.LAVA_DAMAGE - 1, 0)
+    assert np.array_equal(flashed, tinted(plain, 7, 0)) and not np.array_equal(flashed, plain)
+
+
 def test_each_lava_hit_flashes_the_view_red_for_two_steps():
     envs = twins("two_colour", complexity=1)
-    for step in range(1, 17):
+    for step in range(1, 18):
         flashed, plain = step_both(envs)
-        # Hits at tics 23 and 55 (steps 6 and 14): counts 8 - 1 - 1 = 6 and 2 at the next step's end.
-        expected = {6: 6, 7: 2, 14: 6, 15: 2}.get(step, 0)
+        # The first frame's 7 fades to 3 by step 1's end; hits on the last tics of steps 8 and 16
+        # (tics 32 and 64) leave 8 - 1 = 7, then 3.
+        expected = {1: 3, 8: 7, 9: 3, 16: 7, 17: 3}.get(step, 0)
         assert counts(envs[0]) == (expected, 0), step
         assert np.array_equal(flashed, tinted(plain, expected, 0) if expected else plain), step
 
@@ -86,12 +97,13 @@ def test_a_wrong_item_flashes_red_and_gold_a_right_one_gold():
     flashed, plain = step_both(envs, xy=_lone_item(task, not bool(task.state["totem_green"][0])))
     damage = two_colour.WRONG_RED_DAMAGE if bool(task.state["totem_green"][0]) else two_colour.WRONG_GREEN_DAMAGE
     assert int(task.state["health"][0]) == 92 - damage
-    assert counts(envs[0]) == (damage - 3, 6 - 3)  # the count is the damage the armour let through
-    assert np.array_equal(flashed, tinted(plain, damage - 3, 3))
+    # The damage the armour let through adds to the first frame's 7, less its first tic's count-down.
+    assert counts(envs[0]) == (7 - 1 + damage - 3, 6 - 3)
+    assert np.array_equal(flashed, tinted(plain, damage + 3, 3))
     flashed, plain = step_both(envs, xy=_lone_item(task, bool(task.state["totem_green"][0])))
     assert int(task.state["health"][0]) == min(92 - damage + two_colour.ITEM_HEALTH, 100)
-    assert counts(envs[0]) == (damage - 3 - 4, 6 - 3)  # healing does not flash red; the red fades on
-    assert np.array_equal(flashed, tinted(plain, damage - 7, 3))
+    assert counts(envs[0]) == (damage + 3 - 4, 6 - 3)  # healing does not flash red; the red fades on
+    assert np.array_equal(flashed, tinted(plain, damage - 1, 3))
 
 
 def test_the_find_and_return_target_flashes_gold_once():

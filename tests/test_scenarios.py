@@ -214,22 +214,22 @@ def test_pool_covers_a_full_episode():
 
 
 def test_the_floor_takes_8_health_every_32_tics_and_reaching_zero_ends_the_episode():
-    # As ViZDoom plays the released maze (python tools/doom_frames.py --flashes):
-    # 92 at the first frame, 84 from tic 23, 76 from tic 55, ...
+    # As ViZDoom plays the released cfgs (python tools/two_colour_engines.py CHECKOUT --lava):
+    # 92 at the first frame, 84 from tic 32, 76 from tic 64, ...
     env = load("two_colour", complexity=5)
     assert int(env.task.state["health"][0]) == 92
     health = {}
-    for step in range(1, 95):
+    for step in range(1, 97):
         timestep = env.step(TURN_LEFT)  # spinning never touches an item
         health[step * 4] = int(env.task.state["health"][0])
-        if step < 94:
+        if step < 96:
             assert timestep.mid() and timestep.reward == pytest.approx(0.04)
-    assert (health[20], health[24], health[52], health[56]) == (92, 84, 84, 76)
-    # The 12th hit (tic 23 + 11 x 32 = 375) empties it.
+    assert (health[28], health[32], health[60], health[64]) == (92, 84, 84, 76)
+    # The 12th hit (tic 32 + 11 x 32 = 384) empties it: ViZDoom's 96 steps of a walk that picks nothing.
     assert timestep.last() and timestep.discount == 0.0
     assert timestep.reward == 0.0  # the last step was not survived
     info = env.task.get_info(env.physics)
-    assert (info["health"], info["duration"]) == (92 - 12 * 8, 376)
+    assert (info["health"], info["duration"]) == (92 - 12 * 8, 384)
 
 
 def _lone_item(task, green):
@@ -249,7 +249,7 @@ def pick(env, green):
 def test_correct_item_raises_health_and_pays_wrong_one_costs_health():
     env = load("two_colour", complexity=1)
     task = env.task
-    assert int(task.state["health"][0]) == 92  # the floor's first 8 are taken; its next hit is 23 tics in (step 6)
+    assert int(task.state["health"][0]) == 92  # the floor's first 8 are taken; its next hit is 32 tics in (step 8)
     timestep = pick(env, bool(task.state["totem_green"][0]))
     assert int(task.state["health"][0]) == 100  # +25 capped at 100
     assert timestep.reward == pytest.approx(0.04 + 1.0)

@@ -147,18 +147,19 @@ def test_head_bob_moves_each_worlds_eye_and_pistol_as_the_cpu_task():
 
 
 def test_flashes_tint_every_world_as_the_cpu_task():
-    # Two-colour's floor hurts at tic 23 (step 6): counts 6 then 2, red over each world's frame.
+    # Two-colour's floor hurts at tic 32 (step 8's last tic): counts 7 then 3, red over each world's frame;
+    # the first frame's 7 (its own tic's hit) is 3 after step 1.
     kwargs = {"complexity": 1}
     flashed, plain = (mjwarp.MazeBatchEnv(2, "two_colour", device="cpu", flashes=f, **kwargs) for f in (True, False))
     for env in (flashed, plain):
         env.reset(seed=SEED)
-    for step in range(1, 9):
+    for step in range(1, 11):
         actions = torch.tensor([0, 1])  # spin in place: no item is touched
         obs, _, _, _, info = flashed.step(actions)
         obs_plain, *_ = plain.step(actions)
-        damage = {6: 6, 7: 2}.get(step, 0)
+        damage = {1: 3, 8: 7, 9: 3}.get(step, 0)
         assert flashed.state["damage_count"].tolist() == [damage, damage], step
-        assert info["health"].tolist() == [92 if step < 6 else 84] * 2
+        assert info["health"].tolist() == [92 if step < 8 else 84] * 2
         rgb, alpha = look.flash_tint(flashed.xp, flashed.state["damage_count"], flashed.state["bonus_count"])
         assert torch.equal(obs, look.tint(flashed.xp, obs_plain, rgb, alpha)), step
         assert torch.equal(obs, obs_plain) == (damage == 0), step

@@ -12,8 +12,9 @@ Rules
     tic 0; the timer adds one every 30 tics, red first, colours alternating,
     with no cap (as released; at most 91 in an episode, a fixed pool of 91 geoms).
     Health (cap 100) decays as the released maze's floor takes it, Doom's hefty
-    lava: 8 every 32 tics, the first hit already taken at the first observation
-    (health 92), the next 23 tics in, as ViZDoom plays it. An item of the
+    lava: 8 every 32 tics, the first hit taken on the tic of the first
+    observation (health 92, the view flashed red), the next 32 tics in, as
+    ViZDoom plays the released cfgs. An item of the
     totem's colour gives +25; the other colour takes 25 less what the armour
     just picked up absorbs: 17 for a green item, 13 for a red one.
     **Decision**: the released decay and damage, where the paper's spec reads 1
@@ -74,13 +75,18 @@ RED_ARMOUR_SAVES = 0.5  # BlueArmor's, the armour Freedoom draws red
 WRONG_GREEN_DAMAGE = ITEM_HEALTH - int(ITEM_HEALTH * GREEN_ARMOUR_SAVES)
 WRONG_RED_DAMAGE = ITEM_HEALTH - int(ITEM_HEALTH * RED_ARMOUR_SAVES)
 # The released maze's floor is ZDoom's Damage_LavaHefty (sector special 83): 8
-# health when the level's time is a multiple of 32 tics. ViZDoom's first
-# observation is 9 tics into the level, so the first hit has landed (health
-# 92) and the next comes 23 tics in (measured: python tools/doom_frames.py --flashes).
+# health when the level's time is a multiple of 32 tics. The released
+# Two-colour cfgs, unlike the other scenarios' (episode_start_time = 10), set no
+# start time: the first observation is on the tic of a hit (health 92, its red
+# flash at count 7, as a hit on a step's last tic leaves it) and the next hits
+# land 32, 64, ... tics later, so a walk that picks nothing lasts 384 tics
+# (measured: python tools/two_colour_engines.py CHECKOUT --lava; docs/scenarios.md).
 LAVA_DAMAGE = 8
 LAVA_EVERY_TICS = 32
-LAVA_FIRST_TIC = 23
+LAVA_FIRST_TIC = 32
 START_HEALTH = MAX_HEALTH - LAVA_DAMAGE
+# Doom's damage count at the first observation: the hit's 8, less the count-down of its own tic.
+START_DAMAGE_COUNT = LAVA_DAMAGE - 1
 SURVIVAL_REWARD = 0.01 * doom.TICS_PER_STEP
 CORRECT_ITEM_REWARD = 1.0
 # Items appear uniformly where the released script's Spawn succeeds (it retries
@@ -176,6 +182,7 @@ class TwoColour(core.MazeRules):
             "walls": config["walls"],
             "totem_green": totem_green,
             "health": xp.full(batch, START_HEALTH, dtype=xp.int64, device=device),
+            "damage_count": xp.full(batch, START_DAMAGE_COUNT, dtype=xp.int64, device=device),
             "items_spawned": xp.zeros(batch, dtype=xp.int64, device=device),
         }
         first = min(START_ITEMS, self._item_cap)
