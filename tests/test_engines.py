@@ -91,6 +91,21 @@ def test_runs_of_one_engine_under_two_env_ids_are_kept_apart_and_not_averaged(tm
         engines.table(data)
 
 
+def test_a_superseded_env_ids_runs_are_dropped_and_an_unknown_id_is_named(tmp_path):
+    data_file = tmp_path / "engines.json"
+    old = write_run(tmp_path / "old", "mjmaze", 0, np.full(8, 430.0))
+    new = write_run(tmp_path / "new", "mjmaze", 0, np.full(8, 440.0))
+    config = json.loads((new / "config.json").read_text())
+    (new / "config.json").write_text(json.dumps({**config, "env_id": "mjmaze-id-v2"}))
+    engines.add([old, new], data_file)
+    with pytest.raises(SystemExit, match="holds no run of 'mjmaze-id-v3'.*mjmaze-id-v2"):
+        engines.main(["drop", "mjmaze-id-v3", "--data", str(data_file)])
+    engines.main(["drop", "mjmaze-id", "--data", str(data_file)])
+    data = engines.read_data(data_file)
+    assert [r["env_id"] for r in data["runs"]] == ["mjmaze-id-v2"]
+    engines.table(data)  # one env id per engine again: drawn (two raise ValueError)
+
+
 def test_runs_of_two_learners_are_two_curves_each_named_by_its_settings(tmp_path):
     # The default learner (RMSprop eps 1e-5) and the released one (--eps 1e-8).
     data_file = tmp_path / "engines.json"

@@ -3,6 +3,7 @@
     python -m mjmaze.train.engines add runs/two_colour_1_s0 runs/vizdoom_two_colour_1_s0   # into the data file
     python -m mjmaze.train.engines draw       # the plots, and the table in docs/learning.md, from the data file
     python -m mjmaze.train.engines add-released labyrinth_7 OUT/runs/.../labyrinth_7.sh_log.txt   # the paper's code
+    python -m mjmaze.train.engines drop mjmaze/TwoColour-v13     # a superseded version's runs out of the file
 
 ``add`` reads each training run (``--engine mjmaze`` or ``--engine vizdoom``:
 the same A2C, the same settings) and keeps its training curve, in
@@ -148,6 +149,19 @@ def add(run_dirs: list[pathlib.Path], path: pathlib.Path = DATA) -> dict:
         record = run_record(pathlib.Path(run_dir))
         data["runs"] = [r for r in data["runs"] if not same_run(r, record)] + [record]
     data["runs"].sort(key=lambda r: (r["setting"], r["engine"], r["seed"]))
+    files.atomic_write_json(path, data)
+    return data
+
+
+def drop(env_id: str, path: pathlib.Path = DATA) -> dict:
+    """Takes the records of runs that played ``env_id`` out of the data file (a scenario's superseded version, say,
+    before its new runs are drawn: one engine's seeds must share an env id); git keeps what was there."""
+    data = read_data(path, learners=False)
+    kept = [r for r in data["runs"] if r["env_id"] != env_id]
+    if len(kept) == len(data["runs"]):
+        ids = sorted({r["env_id"] for r in data["runs"]})
+        raise ValueError(f"{path} holds no run of {env_id!r}; its env ids: {ids}")
+    data["runs"] = kept
     files.atomic_write_json(path, data)
     return data
 
@@ -417,17 +431,23 @@ def main(argv: list[str] | None = None) -> None:
     releasing = commands.add_parser("add-released", help="put the paper's own trainer's evaluations into the data file")
     releasing.add_argument("setting", help="the setting it trained, e.g. labyrinth_7")
     releasing.add_argument("log", type=pathlib.Path, help="its log (OUT/runs/tmp/results/.../<name>_log.txt)")
+    dropping = commands.add_parser("drop", help="take the runs of one env id out of the data file")
+    dropping.add_argument("env_id", help="e.g. mjmaze/TwoColour-v13, a version a bump superseded")
     drawing = commands.add_parser("draw", help="the plots and docs/learning.md's table from the data file")
     drawing.add_argument("--docs", type=pathlib.Path, default=DOCS, help="where the plots go (default docs/)")
     drawing.add_argument("--page", type=pathlib.Path, default=LEARNING_PAGE,
                          help="the page whose table is rewritten (default docs/learning.md)")
-    for sub in (adding, releasing, drawing):
+    for sub in (adding, releasing, dropping, drawing):
         sub.add_argument("--data", type=pathlib.Path, default=DATA, help=f"the data file (default {DATA})")
     args = parser.parse_args(argv)
     try:
         if args.command == "add":
             data = add(args.runs, args.data)
             print(f"{len(args.runs)} run(s) into {args.data} ({len(data['runs'])} in all)")
+        elif args.command == "drop":
+            before = len(read_data(args.data, learners=False)["runs"])
+            data = drop(args.env_id, args.data)
+            print(f"{before - len(data['runs'])} run(s) of {args.env_id} out of {args.data} ({len(data['runs'])} left)")
         elif args.command == "add-released":
             data = add_released(args.log, args.setting, args.data)
             print(f"the released trainer's evaluations of {args.setting} into {args.data}")
