@@ -17,6 +17,7 @@ from mjmaze.backends import suite
 from mjmaze.build import mjcf
 from mjmaze.drawing import look
 from mjmaze.game import doom
+from mjmaze.scenarios import two_colour
 
 # Actions as ViZDoom played them: forward 12 steps, nothing 8, forward 15, nothing 10.
 HELD = [1] * 12 + [0] * 8 + [1] * 15 + [0] * 10
@@ -36,12 +37,22 @@ VIZDOOM = [
 FORWARD, TURN_LEFT = 2, 0
 
 
-def open_room(head_bob=None, width=320, height=180):
-    """A 10 m room without inner walls or items, the agent at its south end facing north, clear of the totem."""
+# The released Two-colour maze 0 (two_color/1/train, its cfg: no episode_start_time, so ViZDoom's level
+# clock starts at 1), holding forward from the spawn along open floor: after step k = 1..14 the eye's
+# height (CAMERA_POSITION_Z, map units), 9 tics of the clock away from the probe room's swing above.
+VIZDOOM_TWO_COLOUR = [41.87, 42.52, 38.55, 35.81, 41.0, 47.77, 45.47, 36.33, 33.39, 41.0, 48.61, 45.7, 36.3, 33.39]
+
+
+def open_room(head_bob=None, width=320, height=180, level_start_tic=doom.EPISODE_START_TIC):
+    """A 10 m room without inner walls or items, the agent at its south end facing north, clear of the totem.
+
+    ``level_start_tic``: the level's clock at the first observation; ViZDoom's probe room started at 10,
+    as the released cfgs of the other scenarios do (Two-colour's own: 1)."""
     bob = {} if head_bob is None else {"head_bob": head_bob}  # None: the default
     # ViZDoom's probe room had the pistol and no damaging floor: no flashes, the pistol drawn.
     task = suite.make_task("two_colour", {"complexity": 0, "item_cap": 0, "width": width, "height": height,
                                           "random": 0, "flashes": False, "pistol": True, **bob})
+    task.rules.level_start_tic = level_start_tic  # read when the env's frames are first set up
     env = base.make_environment(task)
     env.reset()
     # ViZDoom's start was (0, -500) facing 90 in the same room without the totem (at the centre here).
@@ -80,6 +91,22 @@ def test_walking_swings_the_eye_and_sways_the_pistol_as_vizdoom():
     assert np.abs(np.array(eyes) - (measured[:, 0] - 41.0)).max() < 0.75  # map units (the eye swings 33..49)
     assert np.abs(np.array(corners) - measured[:, 1:]).max() <= 1  # pixels at 320x180 (it sways 14 down, +-10 across)
     env.task.close()
+
+
+def test_two_colours_eye_swings_on_its_own_level_clock_as_vizdoom():
+    env = open_room(level_start_tic=two_colour.LEVEL_START_TIC)
+    eyes = []
+    for _ in VIZDOOM_TWO_COLOUR:
+        env.step(FORWARD)
+        eyes.append(eye_units(env))
+    assert np.abs(np.array(eyes) - (np.array(VIZDOOM_TWO_COLOUR) - 41.0)).max() < 0.75
+    env.task.close()
+
+
+def test_two_colour_keeps_its_released_level_clock():
+    task = suite.make_task("two_colour", {"complexity": 1})
+    assert task.rules.level_start_tic == two_colour.LEVEL_START_TIC == 1
+    assert suite.make_task("labyrinth", {"size": 5}).rules.level_start_tic == doom.EPISODE_START_TIC == 10
 
 
 def step_still(env):

@@ -32,7 +32,8 @@ CLOSE = 9
 def empty_room(room: str, first_item: mjcf.ObjectGeom | None = None):
     """A 10 m arena without walls inside (Two-colour at complexity 0) coloured as ``room`` (a name of
     :data:`mjmaze.build.palette.ROOMS`), objects hidden; ``first_item`` replaces its first item."""
-    task = suite.make_task("two_colour", {"complexity": 0, "item_cap": 0, "random": 0, "room": room})
+    # No flashes: the first frames would carry the floor's hit (Two-colour's first frame is red).
+    task = suite.make_task("two_colour", {"complexity": 0, "item_cap": 0, "random": 0, "room": room, "flashes": False})
     if first_item is not None:
         task.rules.objects = (two_colour.TOTEM, first_item, *two_colour.ITEMS[1:])
     env = base.make_environment(task)
@@ -133,7 +134,7 @@ def test_the_ego_camera_sees_dooms_106_degrees_across():
 def test_two_colour_walls_are_the_released_grey_stone2():
     # The released generator writes every side STONE2, replacing its base map's green-grey
     # GSTONE1: a Two-colour wall is as grey as Labyrinth's (ViZDoom: 38 grey 1 m ahead).
-    env = mjmaze.load("two_colour", task_kwargs={"complexity": 0, "random": 0})
+    env = mjmaze.load("two_colour", task_kwargs={"complexity": 0, "random": 0, "flashes": False})
     env.reset()
     env.physics.show_objects(env.physics.object_ids([o.name for o in env.task.rules.objects]), False)
     red, green, blue = wall_colour(env, 1.0)

@@ -46,7 +46,7 @@ from mjmaze.backends import dm_task as base
 from mjmaze.backends import suite, vizdoom_env
 from mjmaze.build import mjcf, sprites
 from mjmaze.drawing import look
-from mjmaze.game import configs, maze, wall_boxes
+from mjmaze.game import configs, doom, maze, wall_boxes
 
 #: The game data ViZDoom draws with (``--freedoom``): None, the installed ViZDoom's own.
 from mjmaze.scenarios import find_return, k_item, two_colour
@@ -140,8 +140,12 @@ def area_resize(frame: np.ndarray, size: tuple[int, int] = SIZE) -> np.ndarray:
     return cv2.resize(np.asarray(frame, dtype=np.float64), size, interpolation=cv2.INTER_AREA)
 
 
-def released_game(wad: pathlib.Path, weapon: bool = True, variables=(), buttons=None):
-    """A ViZDoom game on ``wad``'s MAP01 with the released settings, its episode started."""
+def released_game(wad: pathlib.Path, weapon: bool = True, variables=(), buttons=None,
+                  start_time: int = doom.EPISODE_START_TIC):
+    """A ViZDoom game on ``wad``'s MAP01 with the released settings, its episode started.
+
+    ``start_time``: the cfg's ``episode_start_time`` (Labyrinth's, Find-and-return's and K-item's 10;
+    Two-colour's cfgs set none: ViZDoom's default 1, ``two_colour.LEVEL_START_TIC``)."""
     import vizdoom as vzd
 
     game = vzd.DoomGame()
@@ -159,7 +163,7 @@ def released_game(wad: pathlib.Path, weapon: bool = True, variables=(), buttons=
     game.set_labels_buffer_enabled(True)
     game.set_window_visible(False)
     game.set_sound_enabled(False)
-    game.set_episode_start_time(10)  # as the released cfg
+    game.set_episode_start_time(start_time)
     game.set_available_buttons(buttons or [vzd.Button.MOVE_FORWARD])
     game.set_available_game_variables(list(variables))
     game.set_doom_skill(5)
@@ -581,7 +585,7 @@ def flashes() -> None:
     with tempfile.TemporaryDirectory() as folder:
         wad = pathlib.Path(folder) / "maze.wad"
         write_wad(wad, text)
-        game = released_game(wad, weapon=True,
+        game = released_game(wad, weapon=True, start_time=two_colour.LEVEL_START_TIC,
                              variables=[vzd.GameVariable.HEALTH, vzd.GameVariable.ARMOR])
         print("tic  health armour  frame mean  ceiling patch")
         for tic in range(70):
@@ -627,7 +631,8 @@ def two_colour_script(basefile: pathlib.Path, episodes: int = 32, complexity: in
                       Thing(*totem, 9001, 10)]
             wad = pathlib.Path(folder) / f"two_colour_{episode}.wad"
             write_wad(wad, textmap(config, (*spawn, 0), things, SLIME, LAVA_HEFTY, origin), behavior)
-            game = released_game(wad, weapon=False, variables=[vzd.GameVariable.HEALTH], buttons=buttons)
+            game = released_game(wad, weapon=False, variables=[vzd.GameVariable.HEALTH], buttons=buttons,
+                                 start_time=two_colour.LEVEL_START_TIC)
             health, tics = game.get_game_variable(vzd.GameVariable.HEALTH), 0
             while not game.is_episode_finished() and tics < 2100:
                 action = actions[rng.integers(len(actions))]

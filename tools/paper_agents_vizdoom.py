@@ -174,7 +174,7 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
     from mjmaze.scenarios.two_colour import SPAWN_EVERY_TICS as every
 
     info = paper_agents.get(name)
-    two_colour = info.scenario == "two_colour"
+    two_colour_setting = info.scenario == "two_colour"
     _, agent, _ = paper_agents.load(name, paper_dir=checkout)
     folder = pathlib.Path(checkout) / paper_agents.MAZES / info.maze_folder / "test"
     env = mjmaze.load(info.scenario, task_kwargs={**info.task_kwargs, "layouts": str(folder), "head_bob": False})
@@ -182,14 +182,16 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
     same, same_shifted, gaps, by_totem = [], [], [], {}
     for index in range(mazes):
         centre = _maze_centre(folder, index)
-        game = _game(folder / f"custom_scenario{index:03d}.cfg", seed=index, objects=two_colour, wad=wad)
+        game = _game(folder / f"custom_scenario{index:03d}.cfg", seed=index, objects=two_colour_setting, wad=wad)
         path, starts = [], {}  # starts: each item's spawn tic (the script's timer's, seen within a step)
         hidden, start = agent.initial_state(1), torch.ones(1, dtype=torch.bool)
-        health, flashes = game.get_game_variable(vzd.GameVariable.HEALTH), [0, 0]  # damage, bonus counts
+        # Damage, bonus counts; Two-colour's first frame follows the floor's hit on its tic.
+        flashes = [two_colour.START_DAMAGE_COUNT if two_colour_setting else 0, 0]
+        health = game.get_game_variable(vzd.GameVariable.HEALTH)
         while not game.is_episode_finished():
             x, y, angle = (game.get_game_variable(getattr(vzd.GameVariable, v)) for v in _POSE)
-            things = _two_colour_things(game, centre) if two_colour else None
-            if two_colour:
+            things = _two_colour_things(game, centre) if two_colour_setting else None
+            if two_colour_setting:
                 tic = game.get_state().tic
                 for *_, object_id in things[0]:
                     starts.setdefault(object_id, every * ((tic - 1) // every))
@@ -202,22 +204,26 @@ def agreement(name: str, checkout: str, mazes: int = 8, hide_items: bool = False
                          frame, np.roll(frame, 1, axis=1)))
             for _ in range(FRAME_SKIP):  # tic by tic, to follow the flash counters
                 game.make_action(LIMITED_ACTIONS[action], 1)
-                flashes = [max(count - 1, 0) for count in flashes]
                 if game.is_episode_finished():
                     break
                 now = game.get_game_variable(vzd.GameVariable.HEALTH)
-                if now < health:
-                    flashes[0] = min(flashes[0] + int(health - now), arrays.MAX_DAMAGE_COUNT)
-                if now > health or now <= health - 12:  # an item: +25, or a wrong one's 13 or 17
+                drop = int(health - now) if now < health else 0
+                lava = drop == two_colour.LAVA_DAMAGE or drop - two_colour.LAVA_DAMAGE in (
+                    two_colour.WRONG_GREEN_DAMAGE, two_colour.WRONG_RED_DAMAGE)
+                floor = two_colour.LAVA_DAMAGE if lava else 0
+                # Doom's order within a tic: the floor's hit, the counters' count-down, an item's damage.
+                flashes = [max(flashes[0] + floor - 1, 0) + drop - floor, max(flashes[1] - 1, 0)]
+                flashes[0] = min(flashes[0], arrays.MAX_DAMAGE_COUNT)
+                if now > health or drop - floor >= 12:  # an item: +25, or a wrong one's 13 or 17
                     flashes[1] += arrays.BONUS_TICS
                 health = now
         game.close()
         _reset_to(env, index)
         hidden, start = agent.initial_state(1), torch.ones(1, dtype=torch.bool)
         shifted_hidden = agent.initial_state(1)
-        totem = "none" if not two_colour or path[0][4][1] is None else ("green" if path[0][4][1] else "red")
+        totem = "none" if not two_colour_setting or path[0][4][1] is None else ("green" if path[0][4][1] else "red")
         for step, (x, y, yaw, action, things, flashes, doom, shifted) in enumerate(path):
-            if two_colour:
+            if two_colour_setting:
                 _place_two_colour_things(task, env.physics, things, flashes, hide_items, starts)
             task.state["steps"][0] = step  # the things' animations at ViZDoom's tic of this pose
             env.physics.set_agent_pose(x, y, yaw)

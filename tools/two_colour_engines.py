@@ -9,7 +9,8 @@ checkout of the released repository) in ViZDoom, as ``mjmaze.backends.vizdoom_en
 plays them, and the same mazes imported into mjmaze (the released JSON layouts,
 ``../shared/paper/released/mazes`` or ``--layouts``), maze after maze, with the
 same policy, and counts per episode: the right and the wrong items picked up
-(by the totem's colour; ViZDoom's things read from its objects list), the
+(by the totem's colour, ViZDoom's things read from its objects list; neither
+engine counts an episode's last step, after which ViZDoom shows no state), the
 agent's path length (Doom map units), its closest approach to any item, and the
 tics survived. Where a learner's curves differ between the engines, this says
 whether the task hands the same policy the same rewards (docs/notes/learning.md).
@@ -121,6 +122,8 @@ def play_mjmaze(layouts: pathlib.Path, complexity: int, mazes: list[int], player
                 gaps = np.abs(task.state["object_xy"][0, 1:][on_floor] / doom.MAP_UNIT - xy).max(axis=1)
                 closest = min(closest, float(gaps.min()))
             timestep = env.step(player.act(timestep.observation["pixels"]))
+            if timestep.last() or not task.state["object_shown"][0, 0]:
+                continue  # as in ViZDoom: nothing seen after the end; no totem, no right colour
             green = two_colour.ITEM_GREEN[on_floor & ~task.state["object_shown"][0, 1:]]
             totem_green = bool(task.state["totem_green"][0])
             right += int((green == totem_green).sum())

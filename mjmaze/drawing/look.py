@@ -97,13 +97,14 @@ PISTOL = (
 )
 
 
-def view_bob(xp, bob, tics):
+def view_bob(xp, bob, tics, start_tic: int = doom.EPISODE_START_TIC):
     """``(eye_dz, pistol_dx, pistol_dy)`` of ``tics`` tics into an episode whose last tic's bob was ``bob``.
 
     ``eye_dz`` in metres (up), the pistol's shift as fractions of the frame
-    (right, down). Works on floats (``xp = math``) and arrays.
+    (right, down); ``start_tic``: the level's clock at the first observation
+    (``MazeRules.level_start_tic``). Works on floats (``xp = math``) and arrays.
     """
-    level_time = doom.EPISODE_START_TIC + tics
+    level_time = start_tic + tics
     eye_dz = bob / 2 * xp.sin(math.tau * (level_time - 1) / EYE_BOB_TICS) * doom.MAP_UNIT
     angle = math.tau * level_time / PISTOL_BOB_TICS
     pistol_dx = bob * xp.cos(angle) * PISTOL_BOB_PIXELS[0]
@@ -434,6 +435,7 @@ class FramePipeline:
                                 run_warp) if textured else None)
         # The pistol is drawn where the released runs drew it: in the paper's look.
         self._head_bob, self._pistol, self._flashes = view.head_bob, view.pistol and textured, view.flashes
+        self._level_start = rules.level_start_tic
         self._tints: dict[tuple[int, int], tuple] = {}  # (damage, bonus) -> the flash's (rgb, alpha), on numpy
         if self.sprites is not None and len(self.sprites):
             self._sprite_objects = xp.asarray(self.sprites.object_index, device=device)
@@ -455,7 +457,7 @@ class FramePipeline:
         xp = self._xp
         scene = {}
         if self._head_bob:
-            eye_dz, pistol_dx, pistol_dy = view_bob(xp, bob, state["steps"] * doom.TICS_PER_STEP)
+            eye_dz, pistol_dx, pistol_dy = view_bob(xp, bob, state["steps"] * doom.TICS_PER_STEP, self._level_start)
             scene["eye_dz"] = eye_dz
             scene["pistol"] = (xp.astype(xp.round(pistol_dx * self._width), xp.int64),
                                xp.astype(xp.round(pistol_dy * self._height), xp.int64))

@@ -80,6 +80,9 @@ class MazeRules(abc.ABC):
     #: Whether :meth:`start` costs much more than a step's rules for a batch: a batch backend then
     #: starts only the envs that need it, rather than every env under a mask (:mod:`mjmaze.backends.warp`).
     costly_start: bool = False
+    #: Doom's level clock at the first observation (:data:`mjmaze.game.doom.EPISODE_START_TIC`: the tics
+    #: ViZDoom ran before it, the released cfg's ``episode_start_time``); head-bob runs on it.
+    level_start_tic: int = doom.EPISODE_START_TIC
 
     def __init__(
         self,

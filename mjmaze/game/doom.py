@@ -17,6 +17,7 @@ PICKUP_RADIUS = 36 * MAP_UNIT
 
 #: The level's clock (Doom's ``leveltime``) at an episode's first tic: the released
 #: ``.cfg`` files' ``episode_start_time``. Head-bob and the pistol's sway run on it.
+#: Two-colour's cfgs set none: ViZDoom's default, 1 (``MazeRules.level_start_tic``).
 EPISODE_START_TIC = 10
 #: ViZDoom's episode clock (``GameState.tic``) at the first observation; an agent step
 #: adds :data:`TICS_PER_STEP`. Things' animations run on it.

@@ -119,8 +119,9 @@ CHANGES: tuple[Change, ...] = (
            'docs/notes/look.md, "Items"',
            notes={TWO_COLOUR: "11 green and 10 red items at the start, as the released script spawns them"}),
     Change("2026-12-03", "0.2.0", {TWO_COLOUR: 14},
-           "the floor's hits 32 tics apart from the first observation, which shows the hit on its own tic "
-           "(the released Two-colour cfgs set no start time): a walk that picks nothing lasts 384 tics, as in ViZDoom",
+           "the floor's hits and head-bob on the released Two-colour cfgs' level clock (no start time: ViZDoom's 1, "
+           "not 10): the first frame shows a hit's red, the next hit comes 32 tics on, and a walk that picks nothing "
+           "lasts 384 tics, as in ViZDoom",
            "the paper's Two-colour agents, 4 settings (docs/fidelity.md)",
            'docs/scenarios.md, "Decisions"'),
 )

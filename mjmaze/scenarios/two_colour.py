@@ -74,19 +74,22 @@ GREEN_ARMOUR_SAVES = 0.33335  # Doom's GreenArmor SavePercent
 RED_ARMOUR_SAVES = 0.5  # BlueArmor's, the armour Freedoom draws red
 WRONG_GREEN_DAMAGE = ITEM_HEALTH - int(ITEM_HEALTH * GREEN_ARMOUR_SAVES)
 WRONG_RED_DAMAGE = ITEM_HEALTH - int(ITEM_HEALTH * RED_ARMOUR_SAVES)
+# The released Two-colour cfgs, unlike the other scenarios' (episode_start_time =
+# 10), set no start time: ViZDoom runs its default one tic (level time 0) before
+# the first observation. Head-bob and the floor run on that clock.
+LEVEL_START_TIC = 1
 # The released maze's floor is ZDoom's Damage_LavaHefty (sector special 83): 8
-# health when the level's time is a multiple of 32 tics. The released
-# Two-colour cfgs, unlike the other scenarios' (episode_start_time = 10), set no
-# start time: the first observation is on the tic of a hit (health 92, its red
-# flash at count 7, as a hit on a step's last tic leaves it) and the next hits
-# land 32, 64, ... tics later, so a walk that picks nothing lasts 384 tics
-# (measured: python tools/two_colour_engines.py CHECKOUT --lava; docs/scenarios.md).
+# health when the level's time is a multiple of 32 tics. So the first observation
+# follows a hit on its tic (health 92, the red at count 7, as a hit on a step's last
+# tic leaves it) and the next land 32, 64, ... tics later: a walk that picks nothing
+# lasts 384 tics (measured: python tools/two_colour_engines.py CHECKOUT --lava).
 LAVA_DAMAGE = 8
 LAVA_EVERY_TICS = 32
-LAVA_FIRST_TIC = 32
+_LAST_LEVEL_TIC = (LEVEL_START_TIC - 1) % LAVA_EVERY_TICS  # of the tic run before the first observation
+LAVA_FIRST_TIC = LAVA_EVERY_TICS - _LAST_LEVEL_TIC  # the next hit's tic after the first observation: 32
 START_HEALTH = MAX_HEALTH - LAVA_DAMAGE
-# Doom's damage count at the first observation: the hit's 8, less the count-down of its own tic.
-START_DAMAGE_COUNT = LAVA_DAMAGE - 1
+# Doom's damage count at the first observation: the hit's 8, counted down on its own tic and each tic since.
+START_DAMAGE_COUNT = max(LAVA_DAMAGE - 1 - _LAST_LEVEL_TIC, 0)
 SURVIVAL_REWARD = 0.01 * doom.TICS_PER_STEP
 CORRECT_ITEM_REWARD = 1.0
 # Items appear uniformly where the released script's Spawn succeeds (it retries
@@ -133,6 +136,7 @@ class TwoColour(core.MazeRules):
     objects = (TOTEM, *ITEMS)
     # 21 items, each tried at 32 points against every wall box: ~21x a step's spawn.
     costly_start = True
+    level_start_tic = LEVEL_START_TIC
 
     def __init__(
         self,
