@@ -11,7 +11,8 @@ from mjmaze.train.settings import Args
 
 
 def write_run(folder, engine, seed, values, scenario="two_colour", complexity=1, updates_per_bin=4, **learner):
-    """A run folder as train.a2c leaves it: config.json and one metrics line per update (2,048 steps each)."""
+    """A run folder as train.a2c leaves it: config.json and one metrics line per update (2,048 steps each);
+    ``learner``: the learner's settings, or any other config field, as the run saved them."""
     folder.mkdir(parents=True)
     defaults = Args()
     config = {"scenario": scenario, "complexity": complexity, "seed": seed, "engine": engine, "num_envs": 16,
@@ -82,9 +83,7 @@ def test_runs_of_one_engine_under_two_env_ids_are_kept_apart_and_not_averaged(tm
     # and drawing them as one curve's seeds is refused.
     data_file = tmp_path / "engines.json"
     area = write_run(tmp_path / "area", "vizdoom", 0, np.full(8, 440.0))
-    released = write_run(tmp_path / "released", "vizdoom", 0, np.full(8, 450.0))
-    config = json.loads((released / "config.json").read_text())
-    (released / "config.json").write_text(json.dumps({**config, "resize": "released"}))
+    released = write_run(tmp_path / "released", "vizdoom", 0, np.full(8, 450.0), resize="released")
     data = engines.add([area, released], data_file)
     assert sorted(r["env_id"] for r in data["runs"]) == ["vizdoom:two_color/1@paper", "vizdoom:two_color/1@paper+area"]
     with pytest.raises(ValueError, match="keep one env id"):
@@ -94,10 +93,7 @@ def test_runs_of_one_engine_under_two_env_ids_are_kept_apart_and_not_averaged(tm
 def test_a_superseded_env_ids_runs_are_dropped_and_an_unknown_id_is_named(tmp_path):
     data_file = tmp_path / "engines.json"
     old = write_run(tmp_path / "old", "mjmaze", 0, np.full(8, 430.0))
-    new = write_run(tmp_path / "new", "mjmaze", 0, np.full(8, 440.0))
-    config = json.loads((new / "config.json").read_text())
-    (new / "config.json").write_text(json.dumps({**config, "env_id": "mjmaze-id-v2"}))
-    engines.add([old, new], data_file)
+    engines.add([old, write_run(tmp_path / "new", "mjmaze", 0, np.full(8, 440.0), env_id="mjmaze-id-v2")], data_file)
     with pytest.raises(SystemExit, match="holds no run of 'mjmaze-id-v3'.*mjmaze-id-v2"):
         engines.main(["drop", "mjmaze-id-v3", "--data", str(data_file)])
     engines.main(["drop", "mjmaze-id", "--data", str(data_file)])
