@@ -38,13 +38,26 @@ def test_the_table_gives_the_observations_each_engine_needs_to_reach_the_papers_
     rows = engines.table(data).splitlines()[2:]
     assert len(rows) == 3
     level_430, level_530, level_700 = rows
-    assert "| 0.38M (1) | 2.88M (1) | 0.13 **over 1.5×** | – / – |" in level_430  # 440 from the start; ViZDoom climbs
-    assert "> 10.00M (1)" in level_530 and "> 2.1" in level_530  # mjmaze never reaches 530: a bound
+    assert "| 0.38M (seed 0) | 2.88M (seed 0) | 0.13 **over 1.5×** | – / – |" in level_430  # 440 from the start; ViZDoom climbs
+    assert "> 10.00M (seed 0)" in level_530 and "> 2.1" in level_530  # mjmaze never reaches 530: a bound
     # Adding a run again replaces its record (same setting, engine and seed).
     engines.add([write_run(tmp_path / "m0b", "mjmaze", 0, climbing)], data_file)
     data = engines.read_data(data_file)
     assert len(data["runs"]) == 2
     assert engines.table(data).splitlines()[2].endswith("| 1.00 | – / – |")
+
+
+def test_the_table_says_where_each_seed_alone_reaches_a_level_beside_the_seeds_mean(tmp_path):
+    # One seed climbs early, one stays at the floor: their mean reaches 430 late, and the cell says which seed did what.
+    early = np.concatenate([np.full(4, 300.0), np.full(36, 600.0)])  # 3-bin means reach 430 at 1.125M
+    floor = np.full(40, 300.0)
+    data_file = tmp_path / "engines.json"
+    engines.add([write_run(tmp_path / "m0", "mjmaze", 0, early), write_run(tmp_path / "m1", "mjmaze", 1, early),
+                 write_run(tmp_path / "v0", "vizdoom", 0, floor), write_run(tmp_path / "v1", "vizdoom", 1, early)],
+                data_file)
+    level_430 = engines.table(engines.read_data(data_file)).splitlines()[2]
+    # ViZDoom's mean (300, then 450) reaches 430 one bin later than either climbing seed.
+    assert "| 1.12M (seeds 0: 1.12, 1: 1.12) | 1.38M (seeds 0: > 10.00, 1: 1.12) | 0.82 |" in level_430
 
 
 def test_draw_rewrites_only_the_table_between_its_markers(tmp_path):
