@@ -197,8 +197,8 @@ def paper_levels(setting: str) -> list[tuple[int, float]]:
     return [(step, points[step]) for step in LEVEL_STEPS if step in points]
 
 
-def _millions(steps: int | None, last: int) -> str:
-    return f"{steps / 1e6:.2f}M" if steps is not None else f"> {last / 1e6:.2f}M"
+def _millions(steps: int | None, last: int, unit: str = "M") -> str:
+    return f"{steps / 1e6:.2f}{unit}" if steps is not None else f"> {last / 1e6:.2f}{unit}"
 
 
 def _each_seed(records: list[dict], level: float) -> str:
@@ -206,7 +206,7 @@ def _each_seed(records: list[dict], level: float) -> str:
     whether one seed late or all seeds a little late made it."""
     if len(records) == 1:
         return f"seed {records[0]['seed']}"
-    each = [f"{r['seed']}: {_millions(*steps_to_reach([r], level))[:-1]}" for r in sorted(records, key=lambda r: r["seed"])]
+    each = [f"{r['seed']}: {_millions(*steps_to_reach([r], level), unit='')}" for r in sorted(records, key=lambda r: r["seed"])]
     return "seeds " + ", ".join(each)
 
 
