@@ -87,6 +87,19 @@ def test_right_then_wrong_item_ends_the_episode():
         {"items_in_order": 1, "item_score": 0.25, "normalised_return": (0.5 - 0.25 + 2 * STEP) / 2.0})
 
 
+@pytest.mark.parametrize("num_items, wrong_item_reward, paid", [
+    (2, None, -0.5),  # the released K = 2 maps' compiled script (tests/test_vizdoom_env.py measures it)
+    (4, None, -0.25), (6, None, -0.25), (8, None, -0.25),
+    (2, -0.25, -0.25),  # the paper's text, as an argument
+])
+def test_a_wrong_first_item_pays_what_the_released_maps_pay(num_items, wrong_item_reward, paid):
+    env = load("k_item", num_items=num_items, wrong_item_reward=wrong_item_reward)
+    timestep = touch(env, item_positions(env)[1])  # kind 2 while kind 1 is next
+    assert timestep.last() and timestep.discount == 0.0
+    assert timestep.reward == pytest.approx(STEP + paid)
+    assert env.task.metrics()["items_in_order"] == 0
+
+
 @pytest.mark.parametrize("num_items", published.of("k_item").difficulties)
 def test_all_items_in_order_pay_once_each_and_end_the_episode(num_items):
     env = load("k_item", num_items=num_items)

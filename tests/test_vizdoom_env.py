@@ -213,3 +213,27 @@ def test_a_close_after_an_interrupted_step_ends_its_workers_and_their_doom_proce
     envs.close()
     assert not any(process.is_alive() for process in envs.processes)
     assert not _alive(games)
+
+
+@pytest.mark.parametrize("num_items", [2, 4])
+def test_a_wrong_item_pays_in_vizdoom_what_mjmazes_k_item_pays(vizdoom, num_items):
+    # Walk onto the blue armour (kind 2) while the green (kind 1) is next: what the released map's compiled
+    # script pays is what mjmaze's K-item pays (-0.5 at K = 2, whose SCRIPTS lump reads -0.25).
+    from mjmaze.scenarios import k_item
+
+    folder = vizdoom_env.released_folder("k_item", num_items, "train", RELEASED)
+    game = vizdoom_env.released_game(folder / "custom_scenario000.cfg", seed=0, teleport=True, objects=True)
+    try:
+        game.new_episode()
+        armour = next(o for o in game.get_state().objects if o.name == "BlueArmor")
+        game.send_game_command(f"warp {armour.position_x - 50} {armour.position_y}")
+        game.make_action([False] * 5, 1)  # the warp takes effect on the next tic
+        angle = game.get_game_variable(vizdoom.GameVariable.ANGLE)
+        game.make_action([0, 0, 0, 0, angle % 360], 1)  # face +x, towards the armour
+        paid = []
+        while not game.is_episode_finished() and len(paid) < 35:
+            paid.append(game.make_action([0, 0, 1, 0, 0], 1))
+        big = [reward for reward in paid if abs(reward) > 0.1]
+        assert game.is_episode_finished() and big == [pytest.approx(k_item.KItem(num_items).wrong_item_reward - 1e-4)]
+    finally:
+        game.close()

@@ -124,6 +124,10 @@ CHANGES: tuple[Change, ...] = (
            "lasts 384 tics, as in ViZDoom",
            "the paper's Two-colour agents, 4 settings (docs/fidelity.md)",
            'docs/scenarios.md, "Decisions"'),
+    Change("2026-12-06", "0.2.0", {K_ITEM: 12},
+           "a wrong item costs -0.5 at K = 2, as the released K = 2 maps' compiled script pays it (its source and "
+           "the paper say -0.25; K = 4, 6, 8 pay -0.25); `wrong_item_reward` sets it",
+           "K-item 2 learning beside ViZDoom's (docs/learning.md)", 'docs/scenarios.md, "Decisions"'),
 )
 
 

@@ -5,14 +5,17 @@ Action Space
 Observation
     ``pixels``: uint8 RGB ``(64, 112, 3)``.
 Rewards
-    +0.5 for the next item in order; -0.25 for any other item, which ends the
-    episode; -0.0001 per tic (-0.0004 per agent step). The last item pays +0.5
-    once (**decision**: the released implementation paid it twice for K = 4, 6, 8).
+    +0.5 for the next item in order; ``wrong_item_reward`` for any other item,
+    which ends the episode: -0.25, as the paper says, but -0.5 at K = 2, as the
+    released K = 2 maps' compiled script pays it (:data:`RELEASED_WRONG_ITEM_REWARD`);
+    -0.0001 per tic (-0.0004 per agent step). The last item pays +0.5 once
+    (**decision**: the released implementation paid it twice for K = 4, 6, 8).
 Termination
     All K collected or a wrong item (discount 0), or 525 agent steps (discount 1).
 Arguments
     ``num_items`` K (paper: 2, 4, 6, 8; any of 1..8 works), ``size`` (grid, default
-    5; K + 1 cells are needed) and the common task arguments.
+    5; K + 1 cells are needed), ``wrong_item_reward`` (None: the released maps'
+    for K; -0.25 gives the paper's text at K = 2) and the common task arguments.
 Metric
     ``item_score`` = items collected in order / K; also ``items_in_order``,
     ``episode_return`` (the raw return) and ``normalised_return`` (the return
@@ -40,7 +43,14 @@ DEFAULT_SIZE = 5
 SIZES = tuple(range(2, 14))
 CELL_SIZE = 1.25
 NEXT_ITEM_REWARD = 0.5
-WRONG_ITEM_REWARD = -0.25
+WRONG_ITEM_REWARD = -0.25  # the paper's text, and the released K = 4, 6 and 8 maps'
+#: K -> a wrong item's reward where the released maps pay other than :data:`WRONG_ITEM_REWARD`. The
+#: K = 2 maps' SCRIPTS lump (the source) reads -0.25, but the compiled BEHAVIOR lump that Doom runs was
+#: built from other source and pays -0.5 (no -0.25 among its constants; measured in ViZDoom by walking
+#: onto the wrong item: tests/test_vizdoom_env.py). The paper's K-item 2 agents and curves were trained
+#: with it, and the sign of an item picked blindly turns on it: (+0.5 - 0.25) / 2 > 0, (+0.5 - 0.5) / 2 = 0
+#: (docs/scenarios.md, "Decisions").
+RELEASED_WRONG_ITEM_REWARD = {2: -0.5}
 STEP_REWARD = -0.0001 * doom.TICS_PER_STEP
 
 
@@ -69,7 +79,8 @@ class KItem(core.MazeRules):
 
     scenario = "k_item"
 
-    def __init__(self, num_items: int = DEFAULT_NUM_ITEMS, size: int = DEFAULT_SIZE, **kwargs):
+    def __init__(self, num_items: int = DEFAULT_NUM_ITEMS, size: int = DEFAULT_SIZE,
+                 wrong_item_reward: float | None = None, **kwargs):
         core.check_choice("num_items", num_items, NUM_ITEMS)
         core.check_choice("size", size, SIZES)
         if num_items + 1 > size * size:
@@ -78,6 +89,9 @@ class KItem(core.MazeRules):
                 f"but a {size}x{size} grid has {size * size}; use a larger size or fewer items"
             )
         self.num_items = num_items
+        if wrong_item_reward is None:
+            wrong_item_reward = RELEASED_WRONG_ITEM_REWARD.get(num_items, WRONG_ITEM_REWARD)
+        self.wrong_item_reward = float(wrong_item_reward)
         self.objects = tuple(geom for _, geom in KINDS[:num_items])
         layout = configs.LayoutSpec(size, CELL_SIZE, maze.DEFAULT_KEEP_PROBABILITY, num_objects=num_items)
         super().__init__(difficulty=num_items, layout=layout, **kwargs)
@@ -106,7 +120,7 @@ class KItem(core.MazeRules):
         reward = (
             STEP_REWARD
             + NEXT_ITEM_REWARD * xp.astype(correct, xp.float64)
-            + WRONG_ITEM_REWARD * xp.astype(wrong, xp.float64)
+            + self.wrong_item_reward * xp.astype(wrong, xp.float64)
         )
         return reward, wrong | (state["next"] == self.num_items)
 
