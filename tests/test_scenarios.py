@@ -100,6 +100,12 @@ def test_a_wrong_first_item_pays_what_the_released_maps_pay(num_items, wrong_ite
     assert env.task.metrics()["items_in_order"] == 0
 
 
+@pytest.mark.parametrize("bad", [True, float("nan"), "-0.5"])
+def test_a_wrong_item_reward_that_is_no_finite_number_is_one_clear_error(bad):
+    with pytest.raises(ValueError, match="wrong_item_reward must be a finite number"):
+        load("k_item", num_items=2, wrong_item_reward=bad)
+
+
 @pytest.mark.parametrize("num_items", published.of("k_item").difficulties)
 def test_all_items_in_order_pay_once_each_and_end_the_episode(num_items):
     env = load("k_item", num_items=num_items)

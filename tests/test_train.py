@@ -207,6 +207,20 @@ def test_a_run_resumed_with_another_learner_is_refused_with_the_flags_that_go_on
     assert policy.load_run(run)[2]["step"] == 64
 
 
+def test_a_run_of_a_superseded_scenario_version_is_not_resumed_under_the_new_id(tmp_path):
+    # Going on would log the new rules' episodes into a curve config.json then names by the new id alone.
+    run = a2c.train(tiny(tmp_path))
+    latest = checkpoint.checkpoints(run / "checkpoints")[-1]
+    state = torch.load(latest, weights_only=True)
+    state["config"]["env_id"] = "mjmaze/Labyrinth-v11"
+    torch.save(state, latest)
+    before = latest.read_bytes()
+    with pytest.raises(checkpoint.CheckpointError, match=r"trained on mjmaze/Labyrinth-v11, and mjmaze now plays"):
+        a2c.train(tiny(tmp_path, total_steps=64, resume=True))
+    assert latest.read_bytes() == before
+    assert json.loads((run / "config.json").read_text())["env_id"] == mjmaze.GYM_IDS["labyrinth"]
+
+
 def test_a_run_from_before_head_bob_and_flashes_resumes_and_plays_only_without_them(tmp_path):
     run = a2c.train(tiny(tmp_path, head_bob=False, flashes=False))
     latest = checkpoint.checkpoints(run / "checkpoints")[-1]

@@ -45,7 +45,7 @@ def test_each_env_owns_a_block_of_mazes_and_starts_at_its_last_as_released():
     ("labyrinth", [-0.0004] * 525, 525, {"success": 0.0}),
     ("find_return", [-0.0004, 0.4996, -0.0004], 3, {"success": 0.0, "target_found": 1.0}),
     ("find_return", [0.4996, 0.4996], 2, {"success": 1.0, "target_found": 1.0}),
-    ("k_item", [0.4996, -0.0004, -0.2504], 3, {"items_in_order": 1, "item_score": 0.5}),
+    ("k_item", [0.4996, -0.0004, -0.5004], 3, {"items_in_order": 1, "item_score": 0.5}),  # K = 2's wrong: -0.5
     ("two_colour", [0.04] * 100 + [1.04, 0.0], 102, {"duration": 102 * TICS_PER_STEP}),
 ])
 def test_the_metric_is_read_off_the_rewards_the_released_scripts_pay(scenario, rewards, steps, expected):

@@ -93,6 +93,7 @@ def train(args: Args) -> pathlib.Path:
         if not found:
             raise FileNotFoundError(f"--resume: no checkpoint in {checkpoint_dir}")
         state = checkpoint.load(found[-1], config)
+        checkpoint.check_same_version(state["config"], config, found[-1])
     # Lines a killed attempt logged after the checkpoint it goes on from (or,
     # with no checkpoint, before starting over) describe discarded training.
     _trim_metrics(run_dir / "metrics.jsonl", int(state["step"]) if state else 0)

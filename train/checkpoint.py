@@ -45,6 +45,16 @@ def identity_differences(saved: dict, now: dict, keys: tuple[str, ...] = IDENTIT
             if setting_of(saved, k) != setting_of(now, k) and not (on_mjmaze and k in VIZDOOM_ONLY)}
 
 
+def check_same_version(saved: dict, now: dict, path: pathlib.Path) -> None:
+    """Refuses to go on with an mjmaze run that trained on another version of its scenario's id: the curve
+    would mix two sets of rules or looks under one id. (A ViZDoom run's id is its settings, checked above.)"""
+    if setting_of(saved, "engine") != "mjmaze" or "env_id" not in saved or saved["env_id"] == now.get("env_id"):
+        return
+    raise CheckpointError(f"{path} trained on {saved['env_id']}, and mjmaze now plays {now['env_id']} "
+                          "(CHANGELOG.md says what changed); it was left untouched. Train a new run (another "
+                          "--run-name), or go on with the mjmaze release that has its id.")
+
+
 def learner_label(config: dict) -> str:
     """How a run's learner (its config's, or a record's ``learner``: :data:`LEARNER_KEYS`) differs from today's
     defaults, for people to read (``"eps 1e-05"``); "" where it does not."""

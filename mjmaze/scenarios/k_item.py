@@ -30,6 +30,9 @@ Version History
 
 from __future__ import annotations
 
+import math
+import numbers
+
 from mjmaze.build import mjcf, sprites
 from mjmaze.game import configs, core, doom, maze, registry, arrays, versions
 
@@ -91,6 +94,10 @@ class KItem(core.MazeRules):
         self.num_items = num_items
         if wrong_item_reward is None:
             wrong_item_reward = RELEASED_WRONG_ITEM_REWARD.get(num_items, WRONG_ITEM_REWARD)
+        if isinstance(wrong_item_reward, bool) or not isinstance(wrong_item_reward, numbers.Real) \
+                or not math.isfinite(wrong_item_reward):
+            raise ValueError(f"wrong_item_reward must be a finite number (None: the released maps', -0.5 at "
+                             f"K = 2 and -0.25 otherwise), got {wrong_item_reward!r}")
         self.wrong_item_reward = float(wrong_item_reward)
         self.objects = tuple(geom for _, geom in KINDS[:num_items])
         layout = configs.LayoutSpec(size, CELL_SIZE, maze.DEFAULT_KEEP_PROBABILITY, num_objects=num_items)
