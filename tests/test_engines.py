@@ -60,6 +60,24 @@ def test_the_table_says_where_each_seed_alone_reaches_a_level_beside_the_seeds_m
     assert "| 1.12M (seeds 0: 1.12, 1: 1.12) | 1.38M (seeds 0: > 10.00, 1: 1.12) | 0.82 |" in level_430
 
 
+
+def test_the_ratio_sets_only_the_seeds_both_engines_ran_against_each_other(tmp_path):
+    # mjmaze's seed 0 and ViZDoom's seed 0 climb alike; ViZDoom also has a late seed 1, which moves its mean
+    # (the cell: 1.38M) but has nothing on mjmaze to be set against (the ratio: 1.00, not 0.82).
+    early = np.concatenate([np.full(4, 300.0), np.full(36, 600.0)])  # 3-bin means reach 430 at 1.125M
+    late = np.concatenate([np.full(12, 300.0), np.full(28, 600.0)])  # at 3.125M
+    data_file = tmp_path / "engines.json"
+    engines.add([write_run(tmp_path / "m0", "mjmaze", 0, early), write_run(tmp_path / "v0", "vizdoom", 0, early),
+                 write_run(tmp_path / "v1", "vizdoom", 1, late)], data_file)
+    level_430 = engines.table(engines.read_data(data_file)).splitlines()[2]
+    assert "| 1.12M (seed 0) | 1.38M (seeds 0: 1.12, 1: 3.12) | 1.00 (seed 0, run on both) |" in level_430
+    # Runs of different seeds on the two engines are not compared at all.
+    engines.add([write_run(tmp_path / "m2", "mjmaze", 2, early)], data_file)
+    data = engines.read_data(data_file)
+    data["runs"] = [r for r in data["runs"] if not (r["engine"] == "mjmaze" and r["seed"] == 0)]
+    assert "| – (no seed run on both) |" in engines.table(data).splitlines()[2]
+
+
 def test_draw_rewrites_only_the_table_between_its_markers(tmp_path):
     data_file = tmp_path / "engines.json"
     engines.add([write_run(tmp_path / "v0", "vizdoom", 0, np.full(12, 500.0))], data_file)

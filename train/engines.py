@@ -240,7 +240,7 @@ def engine_records(data: dict, setting: str, engine: str, learner: tuple | None 
 
 def table(data: dict) -> str:
     """The markdown table: per setting and paper level, the observations each engine's seeds needed to reach
-    it in training episodes, their ratio, and each engine's greedy test value at the paper's step (the
+    it in training episodes, their ratio over the seeds both ran, and each engine's greedy test value at the paper's step (the
     paper's curves are its periodic greedy evaluations on test mazes, docs/learning.md)."""
     lines = ["| setting | paper's level (its step) | mjmaze: obs to reach it (each seed's) | ViZDoom: obs (each seed's) "
              "| mjmaze ÷ ViZDoom | greedy test there: mjmaze / ViZDoom |",
@@ -251,20 +251,35 @@ def table(data: dict) -> str:
         by_engine = {engine: engine_records(data, setting, engine, learner) for engine in ENGINE_NAMES}
         label = learner_label(learner)
         name = f"{setting} ({label})" if label else setting
+        paired, shared = paired_seeds(by_engine)
         for step, level in paper_levels(setting):
-            cells, reached = [], {}
+            cells = []
             for engine, records in by_engine.items():
                 if not records:
                     cells.append("not run")
                     continue
                 at, last = steps_to_reach(records, level)
-                reached[engine] = (at, last)
                 cells.append(f"{_millions(at, last)} ({_each_seed(records, level)})")
-            ratio = _ratio(reached)
+            ratio = _ratio({engine: steps_to_reach(records, level) for engine, records in paired.items()})
+            if all(by_engine.values()) and not paired:
+                ratio = "– (no seed run on both)"
+            elif paired and shared != sorted({r["seed"] for records in by_engine.values() for r in records}):
+                ratio += f" ({'seed' if len(shared) == 1 else 'seeds'} {', '.join(map(str, shared))}, run on both)"
             greedy = " / ".join(greedy_test_at(records, step) if records else "–" for records in by_engine.values())
             lines.append(f"| {name} | {level:.{digits}f} {units} ({step / 1e6:g}M) | {cells[0]} | {cells[1]} "
                          f"| {ratio} | {greedy} |")
     return "\n".join(lines)
+
+
+def paired_seeds(by_engine: dict[str, list[dict]]) -> tuple[dict[str, list[dict]], list[int]]:
+    """Each engine's records of the seeds both engines ran, and those seeds ({} where none is shared): the ratio
+    compares these alone, for a seed one engine ran and the other did not moves one mean and not the other
+    (one early seed on one side read as the engine learning faster)."""
+    seeds = [{r["seed"] for r in records} for records in by_engine.values()]
+    shared = sorted(set.intersection(*seeds)) if all(seeds) else []
+    if not shared:
+        return {}, []
+    return {engine: [r for r in records if r["seed"] in shared] for engine, records in by_engine.items()}, shared
 
 
 def _ratio(reached: dict) -> str:
