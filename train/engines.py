@@ -240,8 +240,8 @@ def engine_records(data: dict, setting: str, engine: str, learner: tuple | None 
 
 def table(data: dict) -> str:
     """The markdown table: per setting and paper level, the observations each engine's seeds needed to reach
-    it in training episodes, their ratio over the seeds both ran, and each engine's greedy test value at the paper's step (the
-    paper's curves are its periodic greedy evaluations on test mazes, docs/learning.md)."""
+    it in training episodes, their ratio over the seeds both ran, and each engine's greedy test value at the
+    paper's step (the paper's curves are its periodic greedy evaluations on test mazes, docs/learning.md)."""
     lines = ["| setting | paper's level (its step) | mjmaze: obs to reach it (each seed's) | ViZDoom: obs (each seed's) "
              "| mjmaze ÷ ViZDoom | greedy test there: mjmaze / ViZDoom |",
              "|---|---|---|---|---|---|"]
