@@ -9,7 +9,7 @@
 per split - rather than the released "first 128 episodes to finish", which
 favoured short episodes (``--plays`` more times each where the draws' noise
 matters: Two-colour's items, the spawn headings). Actions are the argmax of
-the policy. Writes ``eval.json`` into the run folder (atomically) with each
+the policy (``--sampled``: drawn from it, as in training). Writes ``eval.json`` into the run folder (atomically) with each
 split's metric in the units of the paper's Table 2 and every episode's value,
 and prints the table.
 """
@@ -249,6 +249,8 @@ def main(argv: list[str] | None = None) -> None:
                         "engine the run trained on, mjmaze for random and paper:<setting>)")
     parser.add_argument("--released-dir", default=None,
                         help="with --engine vizdoom: a checkout of the released repository (default: $MJMAZE_PAPER_DIR)")
+    parser.add_argument("--sampled", action="store_true",
+                        help="draw the actions from the policy, as in training, rather than take its argmax")
     cli.difficulty_arguments(parser)  # for random: the scenario and its difficulty
     args = parser.parse_args(argv)
     engine = {} if args.engine is None else {"engine": args.engine}
@@ -261,7 +263,7 @@ def main(argv: list[str] | None = None) -> None:
         else:
             result = evaluate(args.run_dir, args.checkpoint, args.num_envs, args.device, out=args.out,
                               torch_threads=args.torch_threads, plays_per_config=args.plays, seed=args.seed,
-                              engine=engine)
+                              sampled=args.sampled, engine=engine)
     except (checkpoint.CheckpointError, FileNotFoundError, ValueError) as error:
         raise SystemExit(f"error: {error}") from None
     print(format_table(result))
