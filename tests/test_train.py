@@ -291,7 +291,7 @@ def test_evaluation_plays_every_configuration_twice(tmp_path, monkeypatch):
     assert saved["test"]["episodes"] == 8 and saved["units"] == "success %"
     assert saved["test"]["actions"] == "greedy"
     # --sampled plays the same configurations with the actions drawn as in training, into its own file.
-    evaluate.main([str(run), "--num-envs", "4", "--sampled", "--out", str(run / "eval_sampled.json")])
+    evaluate.main([str(run), "--num-envs", "4", "--sampled"])
     sampled = json.loads((run / "eval_sampled.json").read_text())
     assert sampled["test"]["actions"] == "sampled" and sampled["test"]["configs"] == saved["test"]["configs"]
     assert json.loads((run / "eval.json").read_text()) == saved  # the greedy result is left as it was

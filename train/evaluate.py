@@ -9,9 +9,10 @@
 per split - rather than the released "first 128 episodes to finish", which
 favoured short episodes (``--plays`` more times each where the draws' noise
 matters: Two-colour's items, the spawn headings). Actions are the argmax of
-the policy (``--sampled``: drawn from it, as in training). Writes ``eval.json`` into the run folder (atomically) with each
-split's metric in the units of the paper's Table 2 and every episode's value,
-and prints the table.
+the policy (``--sampled``: drawn from it, as in training). Writes ``eval.json``
+(``eval_sampled.json``) into the run folder (atomically) with each split's
+metric in the units of the paper's Table 2 and every episode's value, and
+prints the table.
 """
 
 from __future__ import annotations
@@ -208,13 +209,14 @@ def _evaluate(run_dir, checkpoint_path, num_envs, torch_device, out, num_configs
         result[split] = play_split(agent, args, split, num_envs, torch_device, seed=seed, num_configs=num_configs,
                                    progress=progress, layouts=layouts.get(split), plays_per_config=plays_per_config,
                                    sampled=sampled)
-    files.atomic_write_json(pathlib.Path(out) if out else default_output(run_dir), result)
+    files.atomic_write_json(pathlib.Path(out) if out else default_output(run_dir, sampled), result)
     return result
 
 
-def default_output(source: str | pathlib.Path) -> pathlib.Path:
-    """Where :func:`evaluate` writes by default: the run's ``eval.json`` (``runs/paper/<setting>/eval.json`` for a paper agent)."""
-    return policy.output_folder(str(source)) / "eval.json"
+def default_output(source: str | pathlib.Path, sampled: bool = False) -> pathlib.Path:
+    """Where :func:`evaluate` writes by default: the run's ``eval.json`` (``runs/paper/<setting>/eval.json`` for a paper
+    agent); ``eval_sampled.json`` for sampled actions, so that neither replaces the other."""
+    return policy.output_folder(str(source)) / ("eval_sampled.json" if sampled else "eval.json")
 
 
 def format_table(result: dict) -> str:
@@ -250,7 +252,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--released-dir", default=None,
                         help="with --engine vizdoom: a checkout of the released repository (default: $MJMAZE_PAPER_DIR)")
     parser.add_argument("--sampled", action="store_true",
-                        help="draw the actions from the policy, as in training, rather than take its argmax")
+                        help="draw the actions from the policy, as in training, rather than take its argmax "
+                        "(default output: the run's eval_sampled.json)")
     cli.difficulty_arguments(parser)  # for random: the scenario and its difficulty
     args = parser.parse_args(argv)
     engine = {} if args.engine is None else {"engine": args.engine}
@@ -268,7 +271,7 @@ def main(argv: list[str] | None = None) -> None:
         raise SystemExit(f"error: {error}") from None
     print(format_table(result))
     if result["run"] != "random" or args.out:
-        print(f"written: {args.out or default_output(args.run_dir)}")
+        print(f"written: {args.out or default_output(args.run_dir, args.sampled)}")
 
 
 if __name__ == "__main__":
