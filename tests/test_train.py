@@ -145,6 +145,18 @@ def test_two_update_smoke_run_writes_a_run_folder(tmp_path):
     assert [p.name for p in checkpoint.checkpoints(run / "checkpoints")] == ["step_000000000016.pt", "step_000000000032.pt"]
 
 
+def test_a_seed_fixes_a_run_and_another_seed_trains_another(tmp_path):
+    # Timings aside, a run's log is a function of its seed: two runs of one seed are one run.
+    def log(name, seed):
+        run = a2c.train(tiny(tmp_path, run_name=name, seed=seed, total_steps=48))
+        lines = [json.loads(line) for line in (run / "metrics.jsonl").read_text().splitlines()]
+        return [{k: v for k, v in line.items() if "sps" not in k and "seconds" not in k} for line in lines]
+
+    first = log("first", 0)
+    assert log("again", 0) == first
+    assert [line["policy_loss"] for line in log("other", 1)] != [line["policy_loss"] for line in first]
+
+
 @pytest.mark.slow
 def test_resume_continues_step_count_and_optimizer_state(tmp_path):
     run = a2c.train(tiny(tmp_path, total_steps=32, keep_checkpoints=1))
