@@ -7,7 +7,7 @@ import re
 
 import pytest
 import torch
-from mjmaze.train import a2c, checkpoint, evaluate, policy
+from mjmaze.train import a2c, checkpoint, engines, evaluate, policy
 from mjmaze.train import settings as run_settings
 from mjmaze.train.model import Agent
 
@@ -175,6 +175,25 @@ def test_resume_continues_step_count_and_optimizer_state(tmp_path):
     after = resumed["optimizer"]["state"][0]["square_avg"]
     assert resumed["optimizer"]["state"][0]["step"] == saved["optimizer"]["state"][0]["step"] + 2
     assert not torch.equal(before, after)
+
+
+@pytest.mark.slow
+def test_a_run_started_from_another_runs_checkpoint_goes_on_from_its_step_and_weights(tmp_path):
+    # --init-from: one agent going on in another run (on ViZDoom, another engine) from where the first one stood.
+    first = a2c.train(tiny(tmp_path, total_steps=32))
+    start = checkpoint.checkpoints(first / "checkpoints")[-1]
+    before = start.read_bytes()
+    with pytest.raises(checkpoint.CheckpointError, match="size: checkpoint 5 vs now 7"):
+        a2c.train(tiny(tmp_path, run_name="other_size", size=7, total_steps=64, init_from=str(start)))
+    branch = a2c.train(tiny(tmp_path, run_name="branch", total_steps=64, init_from=str(start), keep_checkpoints=1))
+    steps = [json.loads(line)["step"] for line in (branch / "metrics.jsonl").read_text().splitlines()]
+    assert steps == [48, 64]
+    went_on = checkpoint.load(checkpoint.checkpoints(branch / "checkpoints")[-1])
+    assert went_on["update"] == 4 and went_on["optimizer"]["state"][0]["step"] == 4
+    assert json.loads((branch / "config.json").read_text())["init_from"] == str(start)
+    assert start.read_bytes() == before  # the first run's checkpoint is only read
+    with pytest.raises(ValueError, match="--init-from"):  # not one engine's curve from 0
+        engines.run_record(branch)
 
 
 def test_a_missing_checkpoint_is_named_as_missing(tmp_path):

@@ -3,6 +3,7 @@
     python -m mjmaze.train.a2c --scenario labyrinth --size 5 --total-steps 2000000
     python -m mjmaze.train.a2c --scenario k_item --num-items 4 --total-steps 50000000
     python -m mjmaze.train.a2c --run-name labyrinth_5_s0 --resume        # go on from the last checkpoint
+    python -m mjmaze.train.a2c --engine vizdoom ... --init-from runs/labyrinth_5_s0/checkpoints/step_N.pt  # branch
 
 Everything a run writes goes to ``runs/<name>/``: ``config.json``, ``metrics.jsonl``
 (one line per update), TensorBoard events, and ``checkpoints/`` (periodic and
@@ -94,6 +95,8 @@ def train(args: Args) -> pathlib.Path:
             raise FileNotFoundError(f"--resume: no checkpoint in {checkpoint_dir}")
         state = checkpoint.load(found[-1], config)
         checkpoint.check_same_version(state["config"], config, found[-1])
+    elif args.init_from:
+        state = checkpoint.load(pathlib.Path(args.init_from), config, checkpoint.BRANCH_KEYS)
     # Lines a killed attempt logged after the checkpoint it goes on from (or,
     # with no checkpoint, before starting over) describe discarded training.
     _trim_metrics(run_dir / "metrics.jsonl", int(state["step"]) if state else 0)

@@ -31,6 +31,8 @@ MISSING_MEANS = {"head_bob": False, "flashes": False, "engine": "mjmaze", "freed
                  **{key: getattr(Args, key) for key in LEARNER_KEYS}}
 # Settings that only the ViZDoom engine reads: an mjmaze run's value means nothing.
 VIZDOOM_ONLY = ("freedoom", "resize")
+# What a run started from another run's checkpoint (--init-from) must share with it: all but the engine.
+BRANCH_KEYS = tuple(key for key in IDENTITY_KEYS if key not in ("engine", *VIZDOOM_ONLY))
 
 
 def setting_of(config: dict, key: str):

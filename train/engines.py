@@ -90,6 +90,9 @@ def run_record(run_dir: pathlib.Path) -> dict:
     """A run's curve on the fixed grid of :data:`BIN_STEPS` bins (from the first time limit on) and its evaluations."""
     run = curves.read_run(run_dir)
     config = run["config"]
+    if config.get("init_from"):
+        raise ValueError(f"{run_dir} went on from another run's checkpoint (--init-from {config['init_from']}): "
+                         "its curve is not one engine's from the start; the data file takes runs trained from 0")
     if not len(run["steps"]):
         raise ValueError(f"{run_dir} has no training episodes in metrics.jsonl yet")
     if config.get("num_configs") is not None:

@@ -81,6 +81,10 @@ class _RunSettings:
     """how many checkpoints to keep"""
     resume: bool = False
     """go on from the run's last checkpoint (same optimizer state and step count)"""
+    init_from: str | None = None
+    """start a new run from another run's checkpoint (its network, optimizer state and step count) on this run's
+    engine: one agent going on in both engines says which engine's training climbs the faster from it. The
+    scenario, its difficulty and the learner must match the checkpoint's"""
     progress: bool = True
     """show a progress bar"""
 
