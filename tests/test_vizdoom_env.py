@@ -6,6 +6,7 @@ released repository's); they skip where ViZDoom is not installed.
 
 import json
 import pathlib
+from unittest import mock
 
 import numpy as np
 import pytest
@@ -61,6 +62,18 @@ def test_a_missing_checkout_or_setting_is_one_clear_error(tmp_path, monkeypatch)
         vizdoom_env.released_folder("two_colour", 1, "train", tmp_path)
     with pytest.raises(ValueError, match="released no 'fifth'"):
         vizdoom_env.released_folder("fifth", 1, "train", RELEASED)
+
+
+def test_dooms_config_folder_is_made_before_a_game_starts_in_a_new_working_folder(tmp_path, monkeypatch):
+    # Doom makes ./_vizdoom by stat, then mkdir, and exits on "File exists": a run's 16 workers starting in
+    # a new folder once lost 10 of their games to that race. No ViZDoom needed: the game is a stand-in.
+    folder_there_at_init = []
+    game = mock.MagicMock()
+    game.init.side_effect = lambda: folder_there_at_init.append((tmp_path / "_vizdoom").is_dir())
+    monkeypatch.setattr(vizdoom_env, "_vizdoom", lambda: mock.MagicMock(DoomGame=lambda: game))
+    monkeypatch.chdir(tmp_path)
+    assert vizdoom_env.released_game("custom_scenario000.cfg") is game
+    assert folder_there_at_init == [True]
 
 
 def test_training_flags_the_vizdoom_engine_cannot_play_are_refused():

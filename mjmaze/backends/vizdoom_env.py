@@ -70,6 +70,8 @@ RELEASED_MAZES = {"train": 256, "test": 64}  # the released training command's -
 ORDERS = ("released", "cycle")
 # A reward a released script pays for a goal (+1 exit, +0.5 pillar, start or item), above every per-tic one.
 _GOAL_REWARD = 0.25
+#: The folder Doom keeps its config in, in the working folder (``_vizdoom.ini`` beside it).
+CONFIG_FOLDER = "_vizdoom"
 # The paper's Freedoom: ViZDoom 1.1.4 (the released README's) built with Freedoom 0.10.1.
 PAPER_FREEDOOM_DEB = "http://archive.ubuntu.com/ubuntu/pool/universe/f/freedoom/freedoom_0.10.1-1_all.deb"
 PAPER_FREEDOOM_SHA256 = "91c2b5a7454f684dc0141ea50086e94ae0483c9ab04ba97393bb47e703e18c63"  # its freedoom2.wad
@@ -179,6 +181,9 @@ def released_game(cfg: str | os.PathLike, seed: int = 0, wad: str | None = None,
     game.set_window_visible(False)
     game.set_objects_info_enabled(objects)
     game.set_labels_buffer_enabled(labels)
+    # Doom makes its config folder ./_vizdoom at start by stat, then mkdir, and exits on "File exists": games
+    # started together in a new working folder (a vector env's workers) race on it. Made first, none has to.
+    os.makedirs(CONFIG_FOLDER, exist_ok=True)
     game.init()
     if not head_bob:
         game.send_game_command("movebob 0.0")  # the released --disable_head_bob
