@@ -1,7 +1,9 @@
 """The A2C baseline: returns and losses by hand, a smoke run, checkpoints, resume, evaluation."""
 
+import argparse
 import json
 import math
+import os
 import pathlib
 import re
 
@@ -12,6 +14,10 @@ from mjmaze.train import settings as run_settings
 from mjmaze.train.model import Agent
 
 import mjmaze
+from mjmaze.game import layouts
+
+# CI has the paper's files beside the clone (../shared/paper/released: its mazes' .json layouts among them).
+RELEASED = pathlib.Path(__file__).resolve().parents[2] / "shared" / "paper" / "released"
 
 
 def test_n_step_returns_match_a_hand_computation():
@@ -194,6 +200,59 @@ def test_a_run_started_from_another_runs_checkpoint_goes_on_from_its_step_and_we
     assert start.read_bytes() == before  # the first run's checkpoint is only read
     with pytest.raises(ValueError, match="--init-from"):  # not one engine's curve from 0
         engines.run_record(branch)
+
+
+def released_mazes(tmp_path, **overrides) -> run_settings.Args:
+    if not (RELEASED / "mazes").is_dir():
+        if os.environ.get("CI"):
+            pytest.fail(f"CI must have the paper's released files at {RELEASED}")
+        pytest.skip(f"the paper's released mazes are not at {RELEASED}")
+    return tiny(tmp_path, scenario="k_item", size=None, num_items=2, num_envs=4, released_mazes=True,
+                released_dir=str(RELEASED), **overrides)
+
+
+def test_released_mazes_train_mjmaze_on_the_papers_own_mazes(tmp_path):
+    # One change between the engines: mjmaze's rules and frames on the mazes ViZDoom plays.
+    args = released_mazes(tmp_path)
+    args.validate()
+    folders = args.released_layouts()
+    assert folders == {split: str(RELEASED / "mazes" / "kitem" / "2" / split) for split in ("train", "test")}
+    assert args.env_id() == mjmaze.GYM_IDS["k_item"] + "+released-mazes"  # not a curve of the generated mazes
+    mazes = layouts.load_folder(folders["train"], "k_item")
+    envs = a2c.training_envs(args, torch.device("cpu"))()
+    try:
+        _, info = envs.reset(seed=0)
+        for x, y, index in zip(info["x"], info["y"], info["config_index"]):
+            assert (x, y) == pytest.approx(mazes[index].cell_centre(mazes[index].spawn_cell))
+    finally:
+        envs.close()
+
+
+def test_released_mazes_without_a_checkout_or_on_vizdoom_are_one_clear_error(tmp_path, monkeypatch):
+    monkeypatch.delenv("MJMAZE_PAPER_DIR", raising=False)
+    with pytest.raises(SystemExit, match="--released-dir") as error:
+        a2c.main(["--runs-dir", str(tmp_path), "--run-name", "bad", "--scenario", "k_item", "--num-items", "2",
+                  "--released-mazes", "--no-progress"])
+    assert "\n" not in str(error.value) and not (tmp_path / "bad").exists()
+    with pytest.raises(ValueError, match="drop --released-mazes"):
+        run_settings.Args(engine="vizdoom", released_mazes=True, released_dir=str(tmp_path)).validate()
+
+
+@pytest.mark.slow
+def test_a_run_on_the_released_mazes_is_evaluated_and_filmed_on_them_and_kept_out_of_the_engines_data(
+        tmp_path, monkeypatch):
+    run = a2c.train(released_mazes(tmp_path, total_steps=32))
+    monkeypatch.setattr(evaluate, "EVAL_CONFIGS", 4)
+    result = evaluate.evaluate(run, num_envs=4)
+    assert result["released_mazes"] == run_settings.Args.from_config(json.loads((run / "config.json").read_text())
+                                                                     ).released_layouts()
+    assert result["env_id"] == mjmaze.GYM_IDS["k_item"] + "+released-mazes"
+    parser = argparse.ArgumentParser()
+    policy.policy_arguments(parser)  # what record and analysis read: their films play the same mazes
+    _, task_kwargs, _, _ = policy.policy_from_arguments(parser.parse_args([str(run), "--split", "test"]))
+    assert task_kwargs["layouts"] == result["released_mazes"]["test"]
+    with pytest.raises(ValueError, match="--released-mazes"):
+        engines.run_record(run)
 
 
 def test_a_missing_checkpoint_is_named_as_missing(tmp_path):

@@ -22,17 +22,18 @@ PREFIX, SUFFIX = "step_", ".pt"
 # The learner's settings: a run resumed with others would be two learners' curve under one name.
 LEARNER_KEYS = ("lr", "alpha", "eps", "gamma", "value_coef", "entropy_coef", "max_grad_norm")
 IDENTITY_KEYS = ("scenario", "size", "num_items", "complexity", "num_envs", "num_steps", "head_bob", "flashes",
-                 "engine", "freedoom", "resize", *LEARNER_KEYS)
+                 "engine", "released_mazes", "freedoom", "resize", *LEARNER_KEYS)
 # What a checkpoint's network played (evaluating it needs no optimizer): the identity less the learner.
 PLAY_KEYS = tuple(key for key in IDENTITY_KEYS if key not in LEARNER_KEYS)
 # Settings that runs saved before they existed ran with (ViZDoom's frames: INTER_AREA until 2026-11-29).
-MISSING_MEANS = {"head_bob": False, "flashes": False, "engine": "mjmaze", "freedoom": "paper", "resize": "area",
+MISSING_MEANS = {"head_bob": False, "flashes": False, "engine": "mjmaze", "released_mazes": False, "freedoom": "paper",
+                 "resize": "area",
                  # Every run saved its learner; a config written by hand without it means the default learner.
                  **{key: getattr(Args, key) for key in LEARNER_KEYS}}
 # Settings that only the ViZDoom engine reads: an mjmaze run's value means nothing.
 VIZDOOM_ONLY = ("freedoom", "resize")
-# What a run started from another run's checkpoint (--init-from) must share with it: all but the engine.
-BRANCH_KEYS = tuple(key for key in IDENTITY_KEYS if key not in ("engine", *VIZDOOM_ONLY))
+# What a run started from another run's checkpoint (--init-from) must share with it: all but the engine and its mazes.
+BRANCH_KEYS = tuple(key for key in IDENTITY_KEYS if key not in ("engine", "released_mazes", *VIZDOOM_ONLY))
 
 
 def setting_of(config: dict, key: str):

@@ -93,6 +93,10 @@ def run_record(run_dir: pathlib.Path) -> dict:
     if config.get("init_from"):
         raise ValueError(f"{run_dir} went on from another run's checkpoint (--init-from {config['init_from']}): "
                          "its curve is not one engine's from the start; the data file takes runs trained from 0")
+    if checkpoint.setting_of(config, "released_mazes"):
+        raise ValueError(f"{run_dir} played the released mazes in mjmaze (--released-mazes): a one-change run beside "
+                         "the engines' curves (docs/notes/learning.md), not one engine's curve; the data file takes "
+                         "each engine on its own mazes")
     if not len(run["steps"]):
         raise ValueError(f"{run_dir} has no training episodes in metrics.jsonl yet")
     if config.get("num_configs") is not None:

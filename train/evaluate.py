@@ -201,8 +201,8 @@ def _evaluate(run_dir, checkpoint_path, num_envs, torch_device, out, num_configs
         "task_kwargs": args.task_kwargs(),
         "units": suite.paper_metric(args.scenario)[2],
     }
-    # A paper agent's released mazes (ViZDoom plays its own copies of them).
-    layouts = state.get("layouts", {}) if args.engine == "mjmaze" else {}
+    # A paper agent's released mazes, or a run's that trained on them (ViZDoom plays its own copies of them).
+    layouts = (state.get("layouts") or args.released_layouts()) if args.engine == "mjmaze" else {}
     if layouts:
         result["released_mazes"] = layouts
     for split in ("train", "test"):
@@ -250,7 +250,8 @@ def main(argv: list[str] | None = None) -> None:
                         help="the game to play: mjmaze, or vizdoom (the released .cfg/.wad mazes; default: the "
                         "engine the run trained on, mjmaze for random and paper:<setting>)")
     parser.add_argument("--released-dir", default=None,
-                        help="with --engine vizdoom: a checkout of the released repository (default: $MJMAZE_PAPER_DIR)")
+                        help="with --engine vizdoom, or for a run that trained with --released-mazes: a checkout "
+                        "of the released repository (default: the run's, else $MJMAZE_PAPER_DIR)")
     parser.add_argument("--sampled", action="store_true",
                         help="draw the actions from the policy, as in training, rather than take its argmax "
                         "(default output: the run's eval_sampled.json)")

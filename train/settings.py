@@ -62,7 +62,10 @@ class _RunSettings:
     engine: str = "mjmaze"
     """the game the envs play: mjmaze, or vizdoom (the paper's released .cfg/.wad mazes in ViZDoom, as its code played them; pip install -e ".[vizdoom]" and --released-dir)"""
     released_dir: str | None = None
-    """with --engine vizdoom: a checkout of github.com/edbeeching/3d_control_deep_rl (None: $MJMAZE_PAPER_DIR)"""
+    """with --engine vizdoom or --released-mazes: a checkout of github.com/edbeeching/3d_control_deep_rl (None: $MJMAZE_PAPER_DIR)"""
+    released_mazes: bool = False
+    """with --engine mjmaze: play the paper's released mazes of the setting (their .json layouts in --released-dir:
+    256 train, 64 test) instead of mjmaze's generated ones, as ViZDoom plays them; one change between the engines"""
     freedoom: str = "paper"
     """with --engine vizdoom: the game data: paper (Freedoom 0.10.1, fetched once), vizdoom (ViZDoom's own) or a freedoom2.wad"""
     resize: str = "released"
@@ -129,12 +132,15 @@ class _RunSettings:
             raise ValueError(f"--engine must be one of {ENGINES}, got {self.engine!r}")
         if self.engine == "vizdoom":
             self._validate_vizdoom()
+        self.released_layouts()  # a missing checkout or setting is an error before anything starts
 
     def _validate_vizdoom(self) -> None:
         from mjmaze.backends import vizdoom_env
 
         if self.backend != "cpu":
             raise ValueError("--engine vizdoom runs ViZDoom in worker processes: leave --backend at cpu")
+        if self.released_mazes:
+            raise ValueError("--engine vizdoom always plays the released mazes: drop --released-mazes")
         kwargs = self.task_kwargs()
         unplayable = set(kwargs) - {registry.get(self.scenario).difficulty, "head_bob"}
         if unplayable:
@@ -142,6 +148,17 @@ class _RunSettings:
                              f"--no-head-bob, not {sorted(unplayable)}")
         vizdoom_env.check_resize(self.resize)
         vizdoom_env.released_folder(self.scenario, self.difficulty_value(), "train", self.released_dir)
+
+    def released_layouts(self) -> dict[str, str]:
+        """``{split: folder}`` of the released ``.json`` mazes mjmaze plays with ``--released-mazes`` (a task's
+        ``layouts=``); ``{}`` where it plays its generated ones (or where ViZDoom plays)."""
+        if self.engine != "mjmaze" or not self.released_mazes:
+            return {}
+        from mjmaze.backends import vizdoom_env  # where the released checkout's folders are known
+
+        return {split: str(vizdoom_env.released_folder(self.scenario, self.difficulty_value(), split,
+                                                       self.released_dir, kind="json"))
+                for split in vizdoom_env.RELEASED_MAZES}
 
     def difficulty_value(self) -> int:
         """The difficulty this run plays (the flag, or the scenario's default)."""
@@ -163,7 +180,7 @@ class _RunSettings:
             from mjmaze.backends import vizdoom_env
 
             return vizdoom_env.engine_id(self.scenario, self.difficulty_value(), self.freedoom, self.resize)
-        return registry.get(self.scenario).gym_id
+        return registry.get(self.scenario).gym_id + (RELEASED_MAZES_ID if self.released_mazes else "")
 
     def name(self) -> str:
         if self.run_name:
@@ -173,6 +190,8 @@ class _RunSettings:
 
 
 ENGINES = ("mjmaze", "vizdoom")
+# What an mjmaze run's env id adds when it played the released mazes (--released-mazes), not the generated ones.
+RELEASED_MAZES_ID = "+released-mazes"
 
 # One flag per difficulty argument of the registered scenarios (--size,
 # --num-items, --complexity), read from the registry like the other tools'

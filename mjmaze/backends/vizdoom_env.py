@@ -67,6 +67,8 @@ MAZES = "3dcdrl/scenarios/custom_scenarios"  # in a checkout of the released rep
 RELEASED_FOLDERS = {"labyrinth": "labyrinth", "find_return": "find_return", "k_item": "kitem",
                     "two_colour": "two_color"}
 RELEASED_MAZES = {"train": 256, "test": 64}  # the released training command's --num_mazes_train / _test
+# What a released maze folder holds, by the file kind :func:`released_folder` looks for.
+RELEASED_KINDS = {"cfg": ".cfg/.wad files", "json": ".json layouts"}
 ORDERS = ("released", "cycle")
 # A reward a released script pays for a goal (+1 exit, +0.5 pillar, start or item), above every per-tic one.
 _GOAL_REWARD = 0.25
@@ -131,29 +133,33 @@ def freedoom_path(choice: str) -> str | None:
 
 
 def released_folder(scenario: str, difficulty: int, split: str,
-                    released_dir: str | os.PathLike | None = None) -> pathlib.Path:
-    """The folder of a setting's released ``.cfg``/``.wad`` mazes for ``split``.
+                    released_dir: str | os.PathLike | None = None, kind: str = "cfg") -> pathlib.Path:
+    """The folder of a setting's released mazes for ``split``: holding their ``.cfg``/``.wad`` files (``kind="cfg"``,
+    what ViZDoom plays) or their ``.json`` layouts (``kind="json"``, what mjmaze plays with ``layouts=``).
 
     ``released_dir`` (default ``$MJMAZE_PAPER_DIR``) is a checkout of the
     released repository, or a folder with its ``custom_scenarios`` as ``mazes/``.
     """
     if scenario not in RELEASED_FOLDERS:
-        raise ValueError(f"the paper released no {scenario!r} mazes: ViZDoom plays {', '.join(RELEASED_FOLDERS)}")
+        raise ValueError(f"the paper released no {scenario!r} mazes, only {', '.join(RELEASED_FOLDERS)}'s")
     if split not in RELEASED_MAZES:
         raise ValueError(f"split must be train or test, got {split!r}")
+    if kind not in RELEASED_KINDS:
+        raise ValueError(f"kind must be one of {tuple(RELEASED_KINDS)}, got {kind!r}")
     root = released_dir or os.environ.get("MJMAZE_PAPER_DIR")
     if not root:
-        raise FileNotFoundError(f"the ViZDoom engine plays the released .cfg/.wad mazes: pass released_dir "
-                                f"(--released-dir) or set MJMAZE_PAPER_DIR to a checkout of {RELEASED_REPOSITORY}")
+        raise FileNotFoundError(f"the released mazes ({RELEASED_KINDS[kind]}) come from a checkout of "
+                                f"{RELEASED_REPOSITORY}: pass released_dir (--released-dir) or set MJMAZE_PAPER_DIR")
     root = pathlib.Path(root).expanduser()
     setting = f"{RELEASED_FOLDERS[scenario]}/{difficulty}/{split}"
+    first = f"custom_scenario000.{kind}"
     for folder in (root / MAZES / setting, root / "mazes" / setting):
-        if (folder / "custom_scenario000.cfg").is_file():
+        if (folder / first).is_file():
             return folder
     released = sorted(int(p.name) for p in (root / MAZES / RELEASED_FOLDERS[scenario]).glob("*") if p.name.isdigit())
     hint = f" (released {scenario} difficulties: {released})" if released else ""
-    raise FileNotFoundError(f"{root} holds no {MAZES}/{setting}/custom_scenario000.cfg: point it at a checkout of "
-                            f"{RELEASED_REPOSITORY} with its .cfg/.wad files{hint}")
+    raise FileNotFoundError(f"{root} holds no {MAZES}/{setting}/{first}: point it at a checkout of "
+                            f"{RELEASED_REPOSITORY} with its {RELEASED_KINDS[kind]}{hint}")
 
 
 def released_game(cfg: str | os.PathLike, seed: int = 0, wad: str | None = None, head_bob: bool = True,
