@@ -238,12 +238,21 @@ def test_released_mazes_without_a_checkout_or_on_vizdoom_are_one_clear_error(tmp
         run_settings.Args(engine="vizdoom", released_mazes=True, released_dir=str(tmp_path)).validate()
 
 
+def test_released_mazes_take_at_most_the_released_number_of_training_mazes(tmp_path):
+    with pytest.raises(ValueError, match="released 256 training mazes per setting; with --released-mazes pass at most 256"):
+        released_mazes(tmp_path, num_configs=1024).validate()
+
+
 @pytest.mark.slow
 def test_a_run_on_the_released_mazes_is_evaluated_and_filmed_on_them_and_kept_out_of_the_engines_data(
         tmp_path, monkeypatch):
     run = a2c.train(released_mazes(tmp_path, total_steps=32))
     monkeypatch.setattr(evaluate, "EVAL_CONFIGS", 4)
+    played = []  # the mazes each split's envs were made to play
+    made = evaluate.MazeVectorEnv
+    monkeypatch.setattr(evaluate, "MazeVectorEnv", lambda *a, **kw: played.append(kw.get("layouts")) or made(*a, **kw))
     result = evaluate.evaluate(run, num_envs=4)
+    assert played == [str(RELEASED / "mazes" / "kitem" / "2" / split) for split in ("train", "test")]
     assert result["released_mazes"] == run_settings.Args.from_config(json.loads((run / "config.json").read_text())
                                                                      ).released_layouts()
     assert result["env_id"] == mjmaze.GYM_IDS["k_item"] + "+released-mazes"
@@ -253,6 +262,9 @@ def test_a_run_on_the_released_mazes_is_evaluated_and_filmed_on_them_and_kept_ou
     assert task_kwargs["layouts"] == result["released_mazes"]["test"]
     with pytest.raises(ValueError, match="--released-mazes"):
         engines.run_record(run)
+    # Going on without the flag would put two maze sets under one curve.
+    with pytest.raises(checkpoint.CheckpointError, match="released_mazes: checkpoint True vs now False"):
+        a2c.train(tiny(tmp_path, scenario="k_item", size=None, num_items=2, num_envs=4, total_steps=64, resume=True))
 
 
 def test_a_missing_checkpoint_is_named_as_missing(tmp_path):

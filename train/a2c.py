@@ -82,6 +82,8 @@ class _Stop(Exception):
 def train(args: Args) -> pathlib.Path:
     """Trains, checkpointing as it goes; returns the run's folder."""
     args.validate()
+    if args.released_dir:  # saved whole: evaluation and films find the checkout from any working folder
+        args = dataclasses.replace(args, released_dir=str(pathlib.Path(args.released_dir).expanduser().resolve()))
     run_dir = pathlib.Path(args.runs_dir) / args.name()
     checkpoint_dir = run_dir / "checkpoints"
     # The env id names the scenario's version (look, motion, rules, seeds), as gymnasium's ids do.

@@ -79,11 +79,12 @@ def evaluate_checkpoints(run_dir: pathlib.Path, num_envs: int = 16,
 
 def group_key(config: dict) -> tuple:
     """What makes runs seeds of one curve: the scenario, its difficulty, the number of training configurations,
-    and what the agent saw (head-bob, flashes; runs saved before they existed ran without; the engine), and the
-    learner's settings (``--eps 1e-8``: the released learner's RMSprop)."""
+    and what the agent saw (head-bob, flashes; runs saved before they existed ran without; the engine and its mazes),
+    and the learner's settings (``--eps 1e-8``: the released learner's RMSprop)."""
     return (config["scenario"], config.get("size"), config.get("num_items"), config.get("complexity"),
             config.get("num_configs"), checkpoint.setting_of(config, "head_bob"), checkpoint.setting_of(config, "flashes"),
-            checkpoint.setting_of(config, "engine"), *(config.get(key) for key in checkpoint.LEARNER_KEYS))
+            checkpoint.setting_of(config, "engine"), checkpoint.setting_of(config, "released_mazes"),
+            *(config.get(key) for key in checkpoint.LEARNER_KEYS))
 
 
 def setting(config: dict) -> str:
@@ -96,10 +97,12 @@ def setting(config: dict) -> str:
 
 
 def label(config: dict) -> str:
-    """The setting, and what set this group apart (no head-bob, no flashes, ViZDoom's engine, another learner)."""
+    """The setting, and what set this group apart (no head-bob, no flashes, ViZDoom's engine, the released mazes,
+    another learner)."""
     missing = [name for key, name in (("head_bob", "head-bob"), ("flashes", "flashes"))
                if not checkpoint.setting_of(config, key)]
-    engine = " on ViZDoom" if checkpoint.setting_of(config, "engine") == "vizdoom" else ""
+    engine = (" on ViZDoom" if checkpoint.setting_of(config, "engine") == "vizdoom"
+              else " on the released mazes" if checkpoint.setting_of(config, "released_mazes") else "")
     learner = checkpoint.learner_label(config) if all(key in config for key in checkpoint.LEARNER_KEYS) else ""
     return (setting(config) + engine + (f" (no {', no '.join(missing)})" if missing else "")
             + (f" [{learner}]" if learner else ""))

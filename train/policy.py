@@ -192,6 +192,8 @@ def policy_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--sample", action="store_true", help="sample actions instead of the greedy argmax")
     cli.difficulty_arguments(parser)
     parser.add_argument("--split", default="test", choices=("train", "test"))
+    parser.add_argument("--released-dir", default=None,
+                        help="for a run that trained with --released-mazes: the released checkout (default: the run's)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--torch-threads", type=int, default=INFERENCE_THREADS,
                         help="PyTorch CPU threads (default 1: the network reads one frame per step)")
@@ -210,6 +212,8 @@ def policy_from_arguments(args: argparse.Namespace) -> tuple[str, dict, Policy, 
         policy = Policy(new_agent(scenario, task_kwargs), "uniform", args.seed)
         return scenario, task_kwargs, policy, "random policy"
     run_args, agent, state = load_run(args.source, args.checkpoint)
+    if getattr(args, "released_dir", None):
+        run_args = dataclasses.replace(run_args, released_dir=args.released_dir)
     task_kwargs = {k: v for k, v in run_args.task_kwargs().items() if k != "num_configs"}
     clash = {k: v for k, v in flags.items() if task_kwargs.get(k) != v}
     if clash or args.scenario not in (None, run_args.scenario):

@@ -132,7 +132,7 @@ class _RunSettings:
             raise ValueError(f"--engine must be one of {ENGINES}, got {self.engine!r}")
         if self.engine == "vizdoom":
             self._validate_vizdoom()
-        self.released_layouts()  # a missing checkout or setting is an error before anything starts
+        self._validate_released_mazes()
 
     def _validate_vizdoom(self) -> None:
         from mjmaze.backends import vizdoom_env
@@ -148,6 +148,15 @@ class _RunSettings:
                              f"--no-head-bob, not {sorted(unplayable)}")
         vizdoom_env.check_resize(self.resize)
         vizdoom_env.released_folder(self.scenario, self.difficulty_value(), "train", self.released_dir)
+
+    def _validate_released_mazes(self) -> None:
+        from mjmaze.backends import vizdoom_env
+
+        self.released_layouts()  # a missing checkout or setting is an error before anything starts
+        released = vizdoom_env.RELEASED_MAZES["train"]
+        if self.released_mazes and self.num_configs is not None and self.num_configs > released:
+            raise ValueError(f"--num-configs {self.num_configs}: the paper released {released} training mazes per "
+                             f"setting; with --released-mazes pass at most {released}")
 
     def released_layouts(self) -> dict[str, str]:
         """``{split: folder}`` of the released ``.json`` mazes mjmaze plays with ``--released-mazes`` (a task's

@@ -141,7 +141,7 @@ def released_folder(scenario: str, difficulty: int, split: str,
     released repository, or a folder with its ``custom_scenarios`` as ``mazes/``.
     """
     if scenario not in RELEASED_FOLDERS:
-        raise ValueError(f"the paper released no {scenario!r} mazes, only {', '.join(RELEASED_FOLDERS)}'s")
+        raise ValueError(f"the paper released no {scenario!r} mazes (it released {', '.join(RELEASED_FOLDERS)})")
     if split not in RELEASED_MAZES:
         raise ValueError(f"split must be train or test, got {split!r}")
     if kind not in RELEASED_KINDS:
