@@ -69,9 +69,8 @@ def main() -> None:
         run, checkpoint_path, mode, episodes = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4])
         torch.set_num_threads(1)
         args, agent, _ = policy.load_run(run, checkpoint_path)
-        layouts = args.released_layouts()  # a run that trained on the released mazes plays their test split
         env = mjmaze.load("two_colour", task_kwargs={**args.task_kwargs(), "split": "test", "random": 1,
-                                                     **({"layouts": layouts["test"]} if layouts else {})})
+                                                     **args.layouts_kwargs("test")})
         player = policy.Policy(agent, mode, seed=0)
     right = wrong = 0
     durations = []

@@ -140,13 +140,9 @@ def training_envs(args: Args, device: torch.device) -> functools.partial:
         options = dict(num_workers=args.num_workers, copy=False)
     return functools.partial(
         make_vector_env, args.num_envs, args.scenario, backend=args.backend, autoreset_mode="same_step",
-        split="train", **options, **args.task_kwargs(), **_layouts(args.released_layouts(), "train"),
+        split="train", **options, **args.task_kwargs(), **args.layouts_kwargs("train"),
     )
 
-
-def _layouts(folders: dict[str, str], split: str) -> dict:
-    """The task argument that plays ``split``'s released mazes (``--released-mazes``), or none."""
-    return {"layouts": folders[split]} if folders else {}
 
 
 class _Episodes:

@@ -223,8 +223,7 @@ def policy_from_arguments(args: argparse.Namespace) -> tuple[str, dict, Policy, 
     if "layouts" in state:  # a paper agent plays the released mazes of the split
         task_kwargs["layouts"] = state["layouts"][args.split]
         return run_args.scenario, task_kwargs, policy, f"{args.source} (released, {mode})"
-    if run_args.released_layouts():  # as does a run that trained on them
-        task_kwargs["layouts"] = run_args.released_layouts()[args.split]
+    task_kwargs |= run_args.layouts_kwargs(args.split)  # as does a run that trained on them
     return run_args.scenario, task_kwargs, policy, f"{pathlib.Path(args.source).name} @ {state['step']:,} steps ({mode})"
 
 

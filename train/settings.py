@@ -169,6 +169,11 @@ class _RunSettings:
                                                        self.released_dir, kind="json"))
                 for split in vizdoom_env.RELEASED_MAZES}
 
+    def layouts_kwargs(self, split: str) -> dict:
+        """The task argument that plays ``split``'s released mazes (``--released-mazes``), or none."""
+        folders = self.released_layouts()
+        return {"layouts": folders[split]} if folders else {}
+
     def difficulty_value(self) -> int:
         """The difficulty this run plays (the flag, or the scenario's default)."""
         value = getattr(self, registry.get(self.scenario).difficulty, None)
