@@ -10,7 +10,7 @@ from unittest import mock
 
 import numpy as np
 import pytest
-from mjmaze.train import a2c, evaluate
+from mjmaze.train import a2c, checkpoint, evaluate
 from mjmaze.train.settings import Args
 
 from mjmaze.backends import vizdoom_env
@@ -226,6 +226,51 @@ def test_a_close_after_an_interrupted_step_ends_its_workers_and_their_doom_proce
     envs.close()
     assert not any(process.is_alive() for process in envs.processes)
     assert not _alive(games)
+
+
+def test_a_close_after_the_workers_died_with_a_group_sigterm_ends_cleanly(vizdoom):
+    import os
+    import signal
+
+    envs = vizdoom_env.make_vector_env(2, "two_colour", 1, released_dir=RELEASED, num_configs=2, freedoom="vizdoom")
+    envs.reset(seed=0)
+    games = _doom_processes({process.pid for process in envs.processes})
+    # `timeout`, `kill -- -PGID` and Slurm signal every process of the job: the workers end mid-step with the run.
+    envs.step_async(np.array([FORWARD, FORWARD]))
+    for process in envs.processes:
+        os.kill(process.pid, signal.SIGTERM)
+        process.join(timeout=30)
+    envs.close()  # training saves its checkpoint, then closes: a closed pipe must not raise here
+    assert envs.closed and not any(process.is_alive() for process in envs.processes)
+    assert not _alive(games)
+
+
+@pytest.mark.slow
+def test_a_vizdoom_run_stopped_by_a_sigterm_to_its_process_group_keeps_its_last_step(vizdoom, tmp_path):
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    name = "group"
+    command = [sys.executable, "-m", "mjmaze.train.a2c", "--engine", "vizdoom", "--released-dir", str(RELEASED),
+               "--freedoom", "vizdoom", "--scenario", "two_colour", "--complexity", "1", "--num-envs", "2",
+               "--num-steps", "8", "--total-steps", "100000000", "--checkpoint-every", "1000000000",
+               "--runs-dir", str(tmp_path), "--run-name", name, "--no-progress"]
+    log = tmp_path / "run.log"
+    with open(log, "w") as out:  # its own process group, as a batch job's
+        process = subprocess.Popen(command, stdout=out, stderr=subprocess.STDOUT, start_new_session=True)
+    metrics, deadline = tmp_path / name / "metrics.jsonl", time.monotonic() + 180
+    while not (metrics.exists() and metrics.read_text().count("\n") >= 2):
+        assert process.poll() is None and time.monotonic() < deadline, log.read_text()
+        time.sleep(0.05)
+    os.killpg(process.pid, signal.SIGTERM)
+    process.wait(timeout=180)
+    output = log.read_text()
+    assert process.returncode == 130 and "Traceback" not in output, output
+    saved = checkpoint.checkpoints(tmp_path / name / "checkpoints")
+    assert len(saved) == 1 and checkpoint.load(saved[0])["step"] >= 32 and "stopped at step" in output
 
 
 @pytest.mark.parametrize("num_items", [2, 4])

@@ -365,12 +365,17 @@ def _loop(args, make_envs, envs, agent, optimizer, device, run_dir, step, update
                 next_checkpoint += args.checkpoint_every
     except (KeyboardInterrupt, _Stop):
         stopped = True
-    finally:
+    except BaseException:
         envs.close()
+        raise
+    finally:
         for sig, handler in previous_handlers.items():
             signal.signal(sig, handler)
         log.close()
+    # Saved before the envs close: a close that fails (workers killed by the signal
+    # that stopped us) must not take the steps since the last checkpoint with it.
     path = _save(args, agent, optimizer, step, update, run_dir)
+    envs.close()
     print(f"{'stopped' if stopped else 'done'} at step {step:,}; checkpoint {path}")
     if stopped:
         raise SystemExit(130)

@@ -420,7 +420,20 @@ class ReleasedVectorEnv(gym.vector.AsyncVectorEnv):
     def close_extras(self, timeout: float | None = None, terminate: bool = False) -> None:
         if self._state != gym.vector.async_vector_env.AsyncState.DEFAULT and timeout is None:
             timeout = self.pending_close_timeout
-        super().close_extras(timeout, terminate)
+        try:
+            super().close_extras(timeout, terminate)
+        except (EOFError, OSError):
+            # A worker died with the signal that stopped us (SIGTERM to the whole
+            # process group, as `timeout`, `kill -- -PGID` and Slurm send it): its
+            # pipe is closed. Terminate the others instead of asking them.
+            for process in self.processes:
+                if process.is_alive():
+                    process.terminate()
+            for pipe in self.parent_pipes:
+                if pipe is not None:
+                    pipe.close()
+            for process in self.processes:
+                process.join()
 
 
 def engine_id(scenario: str, difficulty: int, freedoom: str = "paper", resize: str = "released") -> str:
