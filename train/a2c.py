@@ -144,7 +144,6 @@ def training_envs(args: Args, device: torch.device) -> functools.partial:
     )
 
 
-
 class _Episodes:
     """The episodes that ended in a rollout: how many, and each final-info field's sum over them.
 
